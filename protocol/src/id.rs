@@ -1,0 +1,135 @@
+//! CAN identifiers and their priority order; the table is in the [crate docs](crate).
+//!
+//! 11-bit identifiers; a lower id wins arbitration. The blocks leave room so that a new message
+//! slots into its priority class without renumbering the bus.
+
+use crate::node::{Drive, Leg};
+
+/// Highest 11-bit identifier.
+pub const MAX_STANDARD_ID: u16 = 0x7FF;
+
+/// Every message the robot's bus carries, with the node or leg where one layout is used on
+/// several identifiers.
+///
+/// An identifier outside this set is not an error of the sender's making that we can repair:
+/// [`MessageId::from_raw`] returns `None` and the receiver counts it as
+/// [`RejectCause::UnknownId`](crate::RejectCause::UnknownId).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum MessageId {
+    /// Emergency stop: latch or clear. Highest priority on the bus.
+    EStop,
+    /// Lockstep tick from the simulator.
+    Sync,
+    /// Position targets for all 16 leg joints.
+    LegTargets,
+    /// Torque command for both wheels.
+    WheelCommand,
+    /// Joint feedback of one leg.
+    LegFeedback(Leg),
+    /// Feedback of both wheels.
+    WheelFeedback,
+    /// Torso IMU sample.
+    Imu,
+    /// Operator command (the report's keys plus stand, fold, height, speed).
+    TeleopCommand,
+    /// Operator liveness.
+    TeleopHeartbeat,
+    /// Controller mode, faults and body state.
+    ControllerStatus,
+    /// State of one drive.
+    DriveStatus(Drive),
+    /// Counters of frames the controller rejected, by cause.
+    RejectCounters,
+}
+
+impl MessageId {
+    /// Every identifier on the bus, in priority order (highest first).
+    pub const ALL: [MessageId; 19] = [
+        MessageId::EStop,
+        MessageId::Sync,
+        MessageId::LegTargets,
+        MessageId::WheelCommand,
+        MessageId::LegFeedback(Leg::Fl),
+        MessageId::LegFeedback(Leg::Fr),
+        MessageId::LegFeedback(Leg::Bl),
+        MessageId::LegFeedback(Leg::Br),
+        MessageId::WheelFeedback,
+        MessageId::Imu,
+        MessageId::TeleopCommand,
+        MessageId::TeleopHeartbeat,
+        MessageId::ControllerStatus,
+        MessageId::DriveStatus(Drive::LegFl),
+        MessageId::DriveStatus(Drive::LegFr),
+        MessageId::DriveStatus(Drive::LegBl),
+        MessageId::DriveStatus(Drive::LegBr),
+        MessageId::DriveStatus(Drive::Wheel),
+        MessageId::RejectCounters,
+    ];
+
+    /// The 11-bit CAN identifier.
+    pub const fn raw(self) -> u16 {
+        match self {
+            MessageId::EStop => 0x000,
+            MessageId::Sync => 0x010,
+            MessageId::LegTargets => 0x100,
+            MessageId::WheelCommand => 0x101,
+            MessageId::LegFeedback(leg) => 0x180 + leg as u16,
+            MessageId::WheelFeedback => 0x184,
+            MessageId::Imu => 0x185,
+            MessageId::TeleopCommand => 0x200,
+            MessageId::TeleopHeartbeat => 0x201,
+            MessageId::ControllerStatus => 0x400,
+            MessageId::DriveStatus(drive) => 0x410 + drive as u16,
+            MessageId::RejectCounters => 0x600,
+        }
+    }
+
+    /// The message for an identifier, or `None` for an identifier this bus does not define.
+    pub const fn from_raw(raw: u16) -> Option<MessageId> {
+        Some(match raw {
+            0x000 => MessageId::EStop,
+            0x010 => MessageId::Sync,
+            0x100 => MessageId::LegTargets,
+            0x101 => MessageId::WheelCommand,
+            0x180 => MessageId::LegFeedback(Leg::Fl),
+            0x181 => MessageId::LegFeedback(Leg::Fr),
+            0x182 => MessageId::LegFeedback(Leg::Bl),
+            0x183 => MessageId::LegFeedback(Leg::Br),
+            0x184 => MessageId::WheelFeedback,
+            0x185 => MessageId::Imu,
+            0x200 => MessageId::TeleopCommand,
+            0x201 => MessageId::TeleopHeartbeat,
+            0x400 => MessageId::ControllerStatus,
+            0x410 => MessageId::DriveStatus(Drive::LegFl),
+            0x411 => MessageId::DriveStatus(Drive::LegFr),
+            0x412 => MessageId::DriveStatus(Drive::LegBl),
+            0x413 => MessageId::DriveStatus(Drive::LegBr),
+            0x414 => MessageId::DriveStatus(Drive::Wheel),
+            0x600 => MessageId::RejectCounters,
+            _ => return None,
+        })
+    }
+
+    /// Position of this identifier in [`MessageId::ALL`]; indexes per-identifier state tables.
+    pub const fn index(self) -> usize {
+        match self {
+            MessageId::EStop => 0,
+            MessageId::Sync => 1,
+            MessageId::LegTargets => 2,
+            MessageId::WheelCommand => 3,
+            MessageId::LegFeedback(leg) => 4 + leg as usize,
+            MessageId::WheelFeedback => 8,
+            MessageId::Imu => 9,
+            MessageId::TeleopCommand => 10,
+            MessageId::TeleopHeartbeat => 11,
+            MessageId::ControllerStatus => 12,
+            MessageId::DriveStatus(drive) => 13 + drive as usize,
+            MessageId::RejectCounters => 18,
+        }
+    }
+
+    /// E2E data id mixed into the CRC: a frame moved to another identifier fails its CRC check.
+    pub const fn data_id(self) -> u16 {
+        0xC000 | self.raw()
+    }
+}

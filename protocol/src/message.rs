@@ -1,0 +1,196 @@
+//! Any message of the bus, decoded from a raw identifier and data.
+
+use crate::codec::{decode, encode, EncodeError, Message};
+use crate::error::DecodeError;
+use crate::frame::Frame;
+use crate::id::MessageId;
+use crate::msg::{
+    ControllerStatus, DriveStatus, EStop, Imu, LegFeedback, LegTargets, RejectCounters, Sync,
+    TeleopCommand, TeleopHeartbeat, WheelCommand, WheelFeedback,
+};
+use crate::node::{Drive, Leg};
+use crate::signal::Field;
+
+/// A decoded message with the node it concerns, where the identifier names one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[allow(missing_docs)]
+pub enum AnyMessage {
+    EStop(EStop),
+    Sync(Sync),
+    LegTargets(LegTargets),
+    WheelCommand(WheelCommand),
+    LegFeedback(Leg, LegFeedback),
+    WheelFeedback(WheelFeedback),
+    Imu(Imu),
+    TeleopCommand(TeleopCommand),
+    TeleopHeartbeat(TeleopHeartbeat),
+    ControllerStatus(ControllerStatus),
+    DriveStatus(Drive, DriveStatus),
+    RejectCounters(RejectCounters),
+}
+
+/// A frame that passed the stateless checks (id, length, CRC, ranges).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Decoded {
+    /// Which identifier it came on.
+    pub id: MessageId,
+    /// Its rolling counter, for the sequence check.
+    pub counter: u16,
+    /// The message.
+    pub message: AnyMessage,
+}
+
+/// Decodes a frame's identifier and data without sequence state: unknown id, wrong length,
+/// CRC mismatch and out-of-range values are rejected here. Use
+/// [`Receiver`](crate::Receiver) to also reject repeated and out-of-sequence frames.
+pub fn decode_frame(raw_id: u16, data: &[u8]) -> Result<Decoded, DecodeError> {
+    let id = MessageId::from_raw(raw_id).ok_or(DecodeError::UnknownId(raw_id))?;
+    let (message, counter) = match id {
+        MessageId::EStop => decode(id, data).map(|(m, c)| (AnyMessage::EStop(m), c))?,
+        MessageId::Sync => decode(id, data).map(|(m, c)| (AnyMessage::Sync(m), c))?,
+        MessageId::LegTargets => decode(id, data).map(|(m, c)| (AnyMessage::LegTargets(m), c))?,
+        MessageId::WheelCommand => {
+            decode(id, data).map(|(m, c)| (AnyMessage::WheelCommand(m), c))?
+        }
+        MessageId::LegFeedback(leg) => {
+            decode(id, data).map(|(m, c)| (AnyMessage::LegFeedback(leg, m), c))?
+        }
+        MessageId::WheelFeedback => {
+            decode(id, data).map(|(m, c)| (AnyMessage::WheelFeedback(m), c))?
+        }
+        MessageId::Imu => decode(id, data).map(|(m, c)| (AnyMessage::Imu(m), c))?,
+        MessageId::TeleopCommand => {
+            decode(id, data).map(|(m, c)| (AnyMessage::TeleopCommand(m), c))?
+        }
+        MessageId::TeleopHeartbeat => {
+            decode(id, data).map(|(m, c)| (AnyMessage::TeleopHeartbeat(m), c))?
+        }
+        MessageId::ControllerStatus => {
+            decode(id, data).map(|(m, c)| (AnyMessage::ControllerStatus(m), c))?
+        }
+        MessageId::DriveStatus(drive) => {
+            decode(id, data).map(|(m, c)| (AnyMessage::DriveStatus(drive, m), c))?
+        }
+        MessageId::RejectCounters => {
+            decode(id, data).map(|(m, c)| (AnyMessage::RejectCounters(m), c))?
+        }
+    };
+    Ok(Decoded {
+        id,
+        counter,
+        message,
+    })
+}
+
+impl AnyMessage {
+    /// The identifier this message goes out on.
+    pub fn id(&self) -> MessageId {
+        match self {
+            AnyMessage::EStop(_) => MessageId::EStop,
+            AnyMessage::Sync(_) => MessageId::Sync,
+            AnyMessage::LegTargets(_) => MessageId::LegTargets,
+            AnyMessage::WheelCommand(_) => MessageId::WheelCommand,
+            AnyMessage::LegFeedback(leg, _) => MessageId::LegFeedback(*leg),
+            AnyMessage::WheelFeedback(_) => MessageId::WheelFeedback,
+            AnyMessage::Imu(_) => MessageId::Imu,
+            AnyMessage::TeleopCommand(_) => MessageId::TeleopCommand,
+            AnyMessage::TeleopHeartbeat(_) => MessageId::TeleopHeartbeat,
+            AnyMessage::ControllerStatus(_) => MessageId::ControllerStatus,
+            AnyMessage::DriveStatus(drive, _) => MessageId::DriveStatus(*drive),
+            AnyMessage::RejectCounters(_) => MessageId::RejectCounters,
+        }
+    }
+
+    /// Encodes this message with rolling counter `counter`.
+    pub fn encode(&self, counter: u16) -> Result<Frame, EncodeError> {
+        match self {
+            AnyMessage::EStop(m) => encode(m, (), counter),
+            AnyMessage::Sync(m) => encode(m, (), counter),
+            AnyMessage::LegTargets(m) => encode(m, (), counter),
+            AnyMessage::WheelCommand(m) => encode(m, (), counter),
+            AnyMessage::LegFeedback(leg, m) => encode(m, *leg, counter),
+            AnyMessage::WheelFeedback(m) => encode(m, (), counter),
+            AnyMessage::Imu(m) => encode(m, (), counter),
+            AnyMessage::TeleopCommand(m) => encode(m, (), counter),
+            AnyMessage::TeleopHeartbeat(m) => encode(m, (), counter),
+            AnyMessage::ControllerStatus(m) => encode(m, (), counter),
+            AnyMessage::DriveStatus(drive, m) => encode(m, *drive, counter),
+            AnyMessage::RejectCounters(m) => encode(m, (), counter),
+        }
+    }
+}
+
+/// Static description of the message on one identifier.
+#[derive(Debug, Clone, Copy)]
+pub struct Layout {
+    /// Name, unique on the bus (per-node messages carry the node suffix, `LegFeedback_FL`).
+    pub name: &'static str,
+    /// One-line description.
+    pub doc: &'static str,
+    /// Fields in wire order, after the E2E header.
+    pub fields: &'static [Field],
+    /// Bytes of E2E header and payload.
+    pub len: usize,
+    /// CAN FD data length on the wire.
+    pub wire_len: usize,
+}
+
+const fn layout<M: Message>(name: &'static str) -> Layout {
+    Layout {
+        name,
+        doc: M::DOC,
+        fields: M::FIELDS,
+        len: M::LEN,
+        wire_len: M::WIRE_LEN,
+    }
+}
+
+impl MessageId {
+    /// Name, layout and sizes of the message on this identifier.
+    pub const fn layout(self) -> Layout {
+        match self {
+            MessageId::EStop => layout::<EStop>(EStop::NAME),
+            MessageId::Sync => layout::<Sync>(Sync::NAME),
+            MessageId::LegTargets => layout::<LegTargets>(LegTargets::NAME),
+            MessageId::WheelCommand => layout::<WheelCommand>(WheelCommand::NAME),
+            MessageId::LegFeedback(leg) => layout::<LegFeedback>(match leg {
+                Leg::Fl => "LegFeedback_FL",
+                Leg::Fr => "LegFeedback_FR",
+                Leg::Bl => "LegFeedback_BL",
+                Leg::Br => "LegFeedback_BR",
+            }),
+            MessageId::WheelFeedback => layout::<WheelFeedback>(WheelFeedback::NAME),
+            MessageId::Imu => layout::<Imu>(Imu::NAME),
+            MessageId::TeleopCommand => layout::<TeleopCommand>(TeleopCommand::NAME),
+            MessageId::TeleopHeartbeat => layout::<TeleopHeartbeat>(TeleopHeartbeat::NAME),
+            MessageId::ControllerStatus => layout::<ControllerStatus>(ControllerStatus::NAME),
+            MessageId::DriveStatus(drive) => layout::<DriveStatus>(match drive {
+                Drive::LegFl => "DriveStatus_LegFL",
+                Drive::LegFr => "DriveStatus_LegFR",
+                Drive::LegBl => "DriveStatus_LegBL",
+                Drive::LegBr => "DriveStatus_LegBR",
+                Drive::Wheel => "DriveStatus_Wheel",
+            }),
+            MessageId::RejectCounters => layout::<RejectCounters>(RejectCounters::NAME),
+        }
+    }
+
+    /// The node that sends this message.
+    pub const fn sender(self) -> crate::NodeId {
+        use crate::NodeId;
+        match self {
+            MessageId::EStop | MessageId::TeleopCommand | MessageId::TeleopHeartbeat => {
+                NodeId::Teleop
+            }
+            MessageId::Sync => NodeId::Simulator,
+            MessageId::LegTargets
+            | MessageId::WheelCommand
+            | MessageId::ControllerStatus
+            | MessageId::RejectCounters => NodeId::Controller,
+            MessageId::LegFeedback(leg) => leg.drive().node(),
+            MessageId::WheelFeedback => NodeId::WheelDrive,
+            MessageId::Imu => NodeId::Imu,
+            MessageId::DriveStatus(drive) => drive.node(),
+        }
+    }
+}

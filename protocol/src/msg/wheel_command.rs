@@ -1,0 +1,38 @@
+use serde::{Deserialize, Serialize};
+
+use crate::codec::{check_layout, Message};
+use crate::id::MessageId;
+use crate::node::WHEEL_NAMES;
+use crate::signal::{array, Field};
+use crate::units::Torque;
+
+/// Wheel torques, id `0x101`, controller → wheel drive. Zero torque leaves the wheels free.
+///
+/// | byte | field    | type    | meaning                            |
+/// |------|----------|---------|------------------------------------|
+/// | 4–7  | `torque` | 2 × i16 | left, right; 1e-2 N·m, + = forward |
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    Eq,
+    Serialize,
+    Deserialize,
+    postcard::experimental::max_size::MaxSize,
+)]
+pub struct WheelCommand {
+    /// Left, right.
+    pub torque: [Torque; 2],
+}
+
+impl Message for WheelCommand {
+    type Address = ();
+    const NAME: &'static str = "WheelCommand";
+    const DOC: &'static str = "Torque of the left and right wheel";
+    const FIELDS: &'static [Field] = &[array::<Torque>("torque", &WHEEL_NAMES)];
+    fn id(_: ()) -> MessageId {
+        MessageId::WheelCommand
+    }
+}
+check_layout!(WheelCommand);

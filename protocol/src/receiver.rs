@@ -1,0 +1,78 @@
+//! The receiving side of the bus: decode, sequence-check and count every rejection.
+
+use crate::e2e::{E2eChecker, E2eStatus};
+use crate::error::DecodeError;
+use crate::id::MessageId;
+use crate::message::{decode_frame, AnyMessage};
+use crate::msg::RejectCounters;
+
+/// A frame the receiver accepted.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Accepted {
+    /// The message.
+    pub message: AnyMessage,
+    /// Its E2E status: `Ok`, `OkSomeLost` or `Initial`.
+    pub status: E2eStatus,
+}
+
+/// Decodes frames, checks each identifier's rolling counter, and counts every rejection by
+/// cause. Nothing rejected reaches the caller as a message.
+#[derive(Debug, Clone)]
+pub struct Receiver {
+    checkers: [E2eChecker; MessageId::ALL.len()],
+    counters: RejectCounters,
+}
+
+impl Default for Receiver {
+    fn default() -> Self {
+        Self::new(crate::e2e::DEFAULT_MAX_DELTA)
+    }
+}
+
+impl Receiver {
+    /// A receiver that accepts counter steps of 1…`max_delta` on every identifier.
+    pub const fn new(max_delta: u16) -> Self {
+        Self {
+            checkers: [E2eChecker::new(max_delta); MessageId::ALL.len()],
+            counters: RejectCounters {
+                rejected: [crate::units::Count::ZERO; 6],
+                lost: crate::units::Count::ZERO,
+            },
+        }
+    }
+
+    /// Accepts or rejects one frame. A rejection is counted before it is returned.
+    pub fn receive(&mut self, raw_id: u16, data: &[u8]) -> Result<Accepted, DecodeError> {
+        let result = self.check(raw_id, data);
+        match &result {
+            Ok(Accepted {
+                status: E2eStatus::OkSomeLost { lost },
+                ..
+            }) => self.counters.record_lost(*lost),
+            Ok(_) => {}
+            Err(error) => self.counters.record(error.cause()),
+        }
+        result
+    }
+
+    fn check(&mut self, raw_id: u16, data: &[u8]) -> Result<Accepted, DecodeError> {
+        let decoded = decode_frame(raw_id, data)?;
+        let checker = self
+            .checkers
+            .get_mut(decoded.id.index())
+            .ok_or(DecodeError::UnknownId(raw_id))?;
+        let status = checker.check_counter(decoded.counter);
+        match DecodeError::from_e2e(raw_id, status) {
+            Some(error) => Err(error),
+            None => Ok(Accepted {
+                message: decoded.message,
+                status,
+            }),
+        }
+    }
+
+    /// Rejections so far, by cause, and frames lost.
+    pub const fn counters(&self) -> &RejectCounters {
+        &self.counters
+    }
+}

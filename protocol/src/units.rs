@@ -1,0 +1,212 @@
+//! Fixed-point quantities, enumerations and flag sets that appear on the wire.
+//!
+//! Each scalar is an integer count with a decimal scale; its doc comment gives the scale, the
+//! unit and the accepted range. A receiver rejects a raw value outside the range as
+//! [`RejectCause::OutOfRange`](crate::RejectCause::OutOfRange); a sender builds values with
+//! `from_si` (checked) or `saturating_from_si` (clamped).
+
+use crate::wire::{wire_enum, wire_flags, wire_scalar};
+
+wire_scalar!(
+    /// Angle: joint position, body tilt. 1e-4 rad, `i16` (±3.2767 rad).
+    Angle(i16) = I16, exp10 -4, unit "rad", raw i16::MIN, i16::MAX
+);
+wire_scalar!(
+    /// Wheel angle wrapped to one turn. 1e-4 rad, `i16`, accepted −31416…31416 (±π).
+    /// Wheels turn without end; the receiver unwraps from successive samples.
+    WheelAngle(i16) = I16, exp10 -4, unit "rad", raw -31_416, 31_416
+);
+wire_scalar!(
+    /// Joint angular velocity. 1e-3 rad/s, `i16` (±32.767 rad/s).
+    JointVelocity(i16) = I16, exp10 -3, unit "rad/s", raw i16::MIN, i16::MAX
+);
+wire_scalar!(
+    /// Wheel angular velocity. 1e-2 rad/s, `i16` (±327.67 rad/s).
+    WheelVelocity(i16) = I16, exp10 -2, unit "rad/s", raw i16::MIN, i16::MAX
+);
+wire_scalar!(
+    /// Torque of a joint or wheel. 1e-2 N·m, `i16` (±327.67 N·m).
+    Torque(i16) = I16, exp10 -2, unit "N.m", raw i16::MIN, i16::MAX
+);
+wire_scalar!(
+    /// Unit-quaternion component. 1e-4, `i16`, accepted −10000…10000 (±1).
+    QuatComponent(i16) = I16, exp10 -4, unit "", raw -10_000, 10_000
+);
+wire_scalar!(
+    /// Angular rate from the gyro. 1e-3 rad/s, `i16` (±32.767 rad/s).
+    AngularRate(i16) = I16, exp10 -3, unit "rad/s", raw i16::MIN, i16::MAX
+);
+wire_scalar!(
+    /// Specific force from the accelerometer. 1e-2 m/s², `i16` (±327.67 m/s², ±33 g).
+    Acceleration(i16) = I16, exp10 -2, unit "m/s^2", raw i16::MIN, i16::MAX
+);
+wire_scalar!(
+    /// Body height offset from the nominal stance height — the report's elevator range.
+    /// 1e-4 m, `i16`, accepted −1000…1200 (−0.10…+0.12 m).
+    BodyHeight(i16) = I16, exp10 -4, unit "m", raw -1_000, 1_200
+);
+wire_scalar!(
+    /// Speed scale of the commanded motion. 1 %, `u8`, accepted 0…100.
+    SpeedScale(u8) = U8, exp10 0, unit "%", raw 0, 100
+);
+wire_scalar!(
+    /// Control tick count. 1 tick, `u32`; wraps after 2^32 ticks (49.7 days at 1 kHz).
+    Tick(u32) = U32, exp10 0, unit "tick", raw 0, u32::MAX
+);
+wire_scalar!(
+    /// Duration or uptime. 1 ms, `u32`.
+    Millis(u32) = U32, exp10 0, unit "ms", raw 0, u32::MAX
+);
+wire_scalar!(
+    /// Event counter. 1 event, `u16`, wraps.
+    Count(u16) = U16, exp10 0, unit "", raw 0, u16::MAX
+);
+
+impl Count {
+    /// No events.
+    pub const ZERO: Count = Count(0);
+
+    /// Count one more event, wrapping at `u16::MAX`.
+    pub const fn increment(self) -> Self {
+        Self(self.0.wrapping_add(1))
+    }
+}
+
+impl Tick {
+    /// The next tick, wrapping.
+    pub const fn next(self) -> Self {
+        Self(self.0.wrapping_add(1))
+    }
+}
+
+wire_enum!(
+    /// What an E-stop frame asks for.
+    EStopAction {
+        /// Stop all drives and latch the stop.
+        Latch = 1 => "Latch",
+        /// Release a latched stop; the robot stays in STOP until commanded.
+        Clear = 2 => "Clear",
+    }
+);
+
+wire_enum!(
+    /// Whether a drive should servo to its command or go torque-free.
+    DriveEnable {
+        /// Torque-free: the drive applies no torque.
+        Disabled = 0 => "Disabled",
+        /// The drive follows its command.
+        Enabled = 1 => "Enabled",
+    }
+);
+
+wire_enum!(
+    /// Operator request: the report's keys, plus stand and fold.
+    TeleopMode {
+        /// `X`: stop all motion.
+        Stop = 0 => "Stop_X",
+        /// `W`: drive forward on the wheels.
+        WheelForward = 1 => "WheelForward_W",
+        /// `S`: drive backward on the wheels.
+        WheelBackward = 2 => "WheelBackward_S",
+        /// `A`: rotate in place (differential drive).
+        WheelRotate = 3 => "WheelRotate_A",
+        /// `L`: trot forward.
+        TrotForward = 4 => "TrotForward_L",
+        /// `K`: trot backward.
+        TrotBackward = 5 => "TrotBackward_K",
+        /// Stand on the legs.
+        Stand = 6 => "Stand",
+        /// Fold the legs and balance on the wheels.
+        Fold = 7 => "Fold",
+    }
+);
+
+impl TeleopMode {
+    /// The report's key for this mode, if it has one.
+    pub const fn key(self) -> Option<char> {
+        match self {
+            TeleopMode::Stop => Some('X'),
+            TeleopMode::WheelForward => Some('W'),
+            TeleopMode::WheelBackward => Some('S'),
+            TeleopMode::WheelRotate => Some('A'),
+            TeleopMode::TrotForward => Some('L'),
+            TeleopMode::TrotBackward => Some('K'),
+            TeleopMode::Stand | TeleopMode::Fold => None,
+        }
+    }
+
+    /// The mode of one of the report's keys (either case), or `None` for any other key.
+    pub const fn from_key(key: char) -> Option<Self> {
+        Some(match key.to_ascii_uppercase() {
+            'X' => TeleopMode::Stop,
+            'W' => TeleopMode::WheelForward,
+            'S' => TeleopMode::WheelBackward,
+            'A' => TeleopMode::WheelRotate,
+            'L' => TeleopMode::TrotForward,
+            'K' => TeleopMode::TrotBackward,
+            _ => return None,
+        })
+    }
+}
+
+wire_enum!(
+    /// State of the controller's mode machine, as reported in its status.
+    ControllerMode {
+        /// Standing still (the report's STOP).
+        Stop = 0 => "Stop",
+        /// Balancing on the wheels, driving forward.
+        WheelForward = 1 => "WheelForward",
+        /// Balancing on the wheels, driving backward.
+        WheelBackward = 2 => "WheelBackward",
+        /// Balancing on the wheels, turning in place.
+        WheelRotate = 3 => "WheelRotate",
+        /// Trotting forward.
+        TrotForward = 4 => "TrotForward",
+        /// Trotting backward.
+        TrotBackward = 5 => "TrotBackward",
+        /// Moving the legs to the fold pose before the wheels drive.
+        Folding = 6 => "Folding",
+        /// Legs taking the weight before a trot.
+        Standing = 7 => "Standing",
+        /// Emergency stop, latched until cleared.
+        EStop = 8 => "EStop",
+        /// A fault stopped the robot.
+        Fault = 9 => "Fault",
+    }
+);
+
+wire_flags!(
+    /// Why the controller is not (fully) operating. `u16`, one bit per cause.
+    FaultFlags(u16) = U16 {
+        /// An E-stop is latched.
+        ESTOP_LATCHED = 0 => "estop_latched",
+        /// Joint or wheel feedback stopped arriving.
+        FEEDBACK_TIMEOUT = 1 => "feedback_timeout",
+        /// IMU samples stopped arriving.
+        IMU_TIMEOUT = 2 => "imu_timeout",
+        /// The operator's heartbeat stopped arriving.
+        TELEOP_TIMEOUT = 3 => "teleop_timeout",
+        /// The torso tilted past its limit.
+        TILT_LIMIT = 4 => "tilt_limit",
+        /// A drive reported a fault or a timeout.
+        DRIVE_FAULT = 5 => "drive_fault",
+        /// The lockstep clock jumped or restarted.
+        SYNC_LOST = 6 => "sync_lost",
+        /// A computed command was not finite and was replaced by a safe one.
+        NON_FINITE = 7 => "non_finite",
+    }
+);
+
+wire_flags!(
+    /// State of a drive. `u8`, one bit per condition.
+    DriveFlags(u8) = U8 {
+        /// The drive applies torque.
+        ENABLED = 0 => "enabled",
+        /// No valid command arrived within the command timeout; torque is off.
+        TIMED_OUT = 1 => "timed_out",
+        /// The drive detected a fault (over-limit, over-temperature, …); torque is off.
+        FAULT = 2 => "fault",
+        /// The drive saw an E-stop and stays torque-free until it is cleared.
+        ESTOP = 3 => "estop",
+    }
+);

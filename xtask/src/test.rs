@@ -1,0 +1,62 @@
+//! `cargo xtask test`: everything CI checks, in the order that fails fastest.
+
+use std::process::Command;
+
+use crate::setup::{venv_python, MCU_TARGET};
+use crate::util::{cargo, root, run as sh};
+
+/// Crates that must stay `no_std` and free of `f64`.
+const NO_STD_CRATES: [&str; 2] = ["protocol", "firmware"];
+
+pub fn run() -> Result<(), String> {
+    crate::setup::run()?;
+    sh(cargo().args(["fmt", "--all", "--check"]))
+        .map_err(|e| format!("{e}\nformatting differs: run `cargo fmt --all`"))?;
+    sh(cargo().args([
+        "clippy",
+        "--workspace",
+        "--all-targets",
+        "--",
+        "-D",
+        "warnings",
+    ]))?;
+    crate::dbc::run(&["--check".to_string()])?;
+    check_no_f64()?;
+    sh(cargo()
+        .args(["test", "--workspace"])
+        .env("PROTOCOL_PYTHON", venv_python()))?;
+    let mut build = cargo();
+    build.args(["build", "--target", MCU_TARGET]);
+    for krate in NO_STD_CRATES {
+        build.args(["-p", krate]);
+    }
+    sh(&mut build)?;
+    eprintln!("test: all checks passed");
+    Ok(())
+}
+
+/// The no_std crates use only `f32` (the MCU's FPU is single precision): any `f64` in their
+/// sources is an error.
+fn check_no_f64() -> Result<(), String> {
+    let mut offenders = Vec::new();
+    for krate in NO_STD_CRATES {
+        let out = Command::new("git")
+            .args(["grep", "-n", "-w", "f64", "--", &format!("{krate}/src")])
+            .current_dir(root())
+            .output()
+            .map_err(|e| format!("could not run git grep: {e}"))?;
+        offenders.extend(
+            String::from_utf8_lossy(&out.stdout)
+                .lines()
+                .map(str::to_owned),
+        );
+    }
+    if offenders.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "f64 in a no_std crate (use f32):\n{}",
+            offenders.join("\n")
+        ))
+    }
+}
