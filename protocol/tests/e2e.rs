@@ -1,0 +1,121 @@
+//! Every status of the E2E receiver.
+
+use protocol::e2e::{crc, protect, verify, HEADER_LEN};
+use protocol::{E2eChecker, E2eCounter, E2eStatus};
+
+fn checker_after(counters: &[u16]) -> E2eChecker {
+    let mut checker = E2eChecker::new(3);
+    for &c in counters {
+        assert!(checker.check_counter(c).is_accepted(), "setup counter {c}");
+    }
+    checker
+}
+
+#[test]
+fn first_frame_is_initial_then_ok() {
+    let mut checker = E2eChecker::new(3);
+    assert_eq!(checker.check_counter(40), E2eStatus::Initial);
+    assert_eq!(checker.check_counter(41), E2eStatus::Ok);
+}
+
+#[test]
+fn a_gap_within_the_window_is_ok_some_lost() {
+    let mut checker = checker_after(&[10]);
+    assert_eq!(checker.check_counter(13), E2eStatus::OkSomeLost { lost: 2 });
+    assert_eq!(checker.check_counter(14), E2eStatus::Ok);
+}
+
+#[test]
+fn the_same_counter_twice_is_repeated() {
+    let mut checker = checker_after(&[10]);
+    assert_eq!(checker.check_counter(10), E2eStatus::Repeated);
+    assert_eq!(
+        checker.check_counter(11),
+        E2eStatus::Ok,
+        "a repeat does not disturb the sequence"
+    );
+}
+
+#[test]
+fn a_jump_beyond_the_window_or_backwards_is_wrong_sequence() {
+    let mut checker = checker_after(&[10]);
+    assert_eq!(checker.check_counter(14), E2eStatus::WrongSequence);
+    assert_eq!(checker.check_counter(9), E2eStatus::WrongSequence);
+    assert_eq!(
+        checker.check_counter(11),
+        E2eStatus::Ok,
+        "rejected frames do not move the sequence"
+    );
+}
+
+#[test]
+fn a_restarted_sender_is_resynchronised_after_two_consecutive_frames() {
+    let mut checker = checker_after(&[5000, 5001]);
+    assert_eq!(checker.check_counter(0), E2eStatus::WrongSequence);
+    assert_eq!(checker.check_counter(1), E2eStatus::Initial);
+    assert_eq!(checker.check_counter(2), E2eStatus::Ok);
+}
+
+#[test]
+fn a_single_replayed_frame_does_not_resynchronise() {
+    let mut checker = checker_after(&[5000]);
+    assert_eq!(checker.check_counter(100), E2eStatus::WrongSequence);
+    assert_eq!(checker.check_counter(5001), E2eStatus::Ok);
+    assert_eq!(
+        checker.check_counter(101),
+        E2eStatus::WrongSequence,
+        "the replay candidate was dropped"
+    );
+}
+
+#[test]
+fn the_counter_wraps() {
+    let mut checker = checker_after(&[u16::MAX - 1, u16::MAX]);
+    assert_eq!(checker.check_counter(0), E2eStatus::Ok);
+    let mut counter = E2eCounter::starting_at(u16::MAX);
+    assert_eq!((counter.advance(), counter.advance()), (u16::MAX, 0));
+}
+
+#[test]
+fn a_corrupted_message_is_crc_error_and_leaves_the_sequence_alone() {
+    let data_id = 0xC123;
+    let mut message = [0_u8; HEADER_LEN + 6];
+    message[HEADER_LEN..].copy_from_slice(b"robot!");
+    protect(data_id, 7, &mut message);
+    assert_eq!(verify(data_id, &message), Some(7));
+
+    let mut checker = E2eChecker::default();
+    let mut corrupted = message;
+    corrupted[HEADER_LEN + 2] ^= 0x10;
+    assert_eq!(
+        checker.check_message(data_id, &corrupted),
+        E2eStatus::CrcError
+    );
+    assert_eq!(
+        checker.check_message(data_id ^ 1, &message),
+        E2eStatus::CrcError,
+        "wrong data id"
+    );
+    assert_eq!(checker.check_message(data_id, &message), E2eStatus::Initial);
+    assert_eq!(
+        checker.check_message(data_id, &message),
+        E2eStatus::Repeated
+    );
+}
+
+#[test]
+fn crc_is_ccitt_false_over_data_then_data_id() {
+    // CRC-16/CCITT-FALSE check value: "123456789" → 0x29B1; the data id is appended low byte
+    // first, so the E2E CRC equals the plain CRC of the concatenation.
+    let reference = crc::Crc::<u16>::new(&crc::CRC_16_IBM_3740);
+    assert_eq!(reference.checksum(b"123456789"), 0x29B1);
+    let mut concatenated = b"123456789".to_vec();
+    concatenated.extend_from_slice(&[0x12, 0x34]);
+    assert_eq!(crc(0x3412, b"123456789"), reference.checksum(&concatenated));
+}
+
+#[test]
+fn too_short_messages_are_never_verified() {
+    assert_eq!(verify(0, &[]), None);
+    assert_eq!(verify(0, &[1, 2, 3]), None);
+}
