@@ -4,7 +4,8 @@ use crate::e2e::{E2eChecker, E2eStatus};
 use crate::error::DecodeError;
 use crate::id::MessageId;
 use crate::message::{decode_frame, AnyMessage};
-use crate::msg::RejectCounters;
+use crate::msg::{EStop, RejectCounters};
+use crate::units::EStopAction;
 
 /// A frame the receiver accepted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -17,6 +18,12 @@ pub struct Accepted {
 
 /// Decodes frames, checks each identifier's rolling counter, and counts every rejection by
 /// cause. Nothing rejected reaches the caller as a message.
+///
+/// One exception is deliberate: an E-stop **latch** with a valid CRC is accepted whatever its
+/// counter (its status still says `Repeated` or `WrongSequence`), because acting on a stale or
+/// repeated latch can only stop the robot, while dropping a genuine one — say from an
+/// operator's `cansend` that cannot know the counter — could hurt someone. An E-stop **clear**
+/// passes every check.
 #[derive(Debug, Clone)]
 pub struct Receiver {
     checkers: [E2eChecker; MessageId::ALL.len()],
@@ -62,9 +69,16 @@ impl Receiver {
             .get_mut(decoded.id.index())
             .ok_or(DecodeError::UnknownId(raw_id))?;
         let status = checker.check_counter(decoded.counter);
+        let fail_safe = matches!(
+            decoded.message,
+            AnyMessage::EStop(EStop {
+                action: EStopAction::Latch,
+                ..
+            })
+        );
         match DecodeError::from_e2e(raw_id, status) {
-            Some(error) => Err(error),
-            None => Ok(Accepted {
+            Some(error) if !fail_safe => Err(error),
+            _ => Ok(Accepted {
                 message: decoded.message,
                 status,
             }),

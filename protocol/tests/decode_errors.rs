@@ -252,3 +252,42 @@ fn errors_explain_themselves() {
         "{text}"
     );
 }
+
+#[test]
+fn an_estop_latch_acts_whatever_its_counter_but_a_clear_must_be_in_sequence() {
+    let latch = EStop {
+        action: EStopAction::Latch,
+        source: NodeId::Tool,
+    };
+    let clear = EStop {
+        action: EStopAction::Clear,
+        source: NodeId::Tool,
+    };
+    let mut rx = Receiver::default();
+    for counter in [500, 501] {
+        let f = encode(&latch, (), counter).unwrap();
+        assert!(rx.receive(f.id(), f.data()).is_ok());
+    }
+    // An operator's cansend with counter 0, twice: both latches act, flagged by their status.
+    let operator = encode(&latch, (), 0).unwrap();
+    let first = rx.receive(operator.id(), operator.data()).unwrap();
+    assert_eq!(first.status, E2eStatus::WrongSequence);
+    assert_eq!(first.message, AnyMessage::EStop(latch));
+    assert!(rx.receive(operator.id(), operator.data()).is_ok());
+    assert_eq!(rx.counters().total(), 0);
+    // A clear out of sequence is rejected; a corrupted latch is rejected too.
+    let stale_clear = encode(&clear, (), 3).unwrap();
+    assert_eq!(
+        rx.receive(stale_clear.id(), stale_clear.data()),
+        Err(DecodeError::WrongSequence { id: 0 })
+    );
+    let mut corrupted = operator.data().to_vec();
+    corrupted[4] ^= 0x03;
+    assert_eq!(
+        rx.receive(operator.id(), &corrupted),
+        Err(DecodeError::CrcMismatch { id: 0 })
+    );
+    // The genuine sequence's next clear is accepted.
+    let clear_next = encode(&clear, (), 502).unwrap();
+    assert!(rx.receive(clear_next.id(), clear_next.data()).is_ok());
+}
