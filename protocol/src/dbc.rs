@@ -7,6 +7,9 @@
 
 use core::fmt::{self, Write};
 
+/// A signal name, built on the stack (no heap in this crate).
+type Name = heapless::String<64>;
+
 use crate::e2e::HEADER_LEN;
 use crate::id::MessageId;
 use crate::node::NodeId;
@@ -126,14 +129,14 @@ fn write_field_element<W: Write>(
     start_bit: usize,
     rx: &[NodeId],
 ) -> fmt::Result {
-    let mut name: heapless_name::Name = heapless_name::Name::new();
+    let mut name = Name::new();
     write!(name, "{}", field.name)?;
     if let Some(instance) = field.instances.get(element) {
         write!(name, "_{instance}")?;
     }
     if !field.flags.is_empty() {
         for (bit, flag) in field.flags.iter().enumerate() {
-            let mut flag_name = heapless_name::Name::new();
+            let mut flag_name = Name::new();
             write!(flag_name, "{}_{}", name.as_str(), flag)?;
             write_signal(
                 out,
@@ -244,45 +247,4 @@ fn write_value_tables<W: Write>(out: &mut W, id: MessageId) -> fmt::Result {
         }
     }
     Ok(())
-}
-
-/// A signal name built on the stack (no heap in this crate).
-mod heapless_name {
-    use core::fmt;
-
-    const CAPACITY: usize = 64;
-
-    /// Up to 64 bytes of name.
-    pub struct Name {
-        buf: [u8; CAPACITY],
-        len: usize,
-    }
-
-    impl Name {
-        pub const fn new() -> Self {
-            Self {
-                buf: [0; CAPACITY],
-                len: 0,
-            }
-        }
-
-        pub fn as_str(&self) -> &str {
-            self.buf
-                .get(..self.len)
-                .and_then(|bytes| core::str::from_utf8(bytes).ok())
-                .unwrap_or("")
-        }
-    }
-
-    impl fmt::Write for Name {
-        fn write_str(&mut self, s: &str) -> fmt::Result {
-            let end = self.len.checked_add(s.len()).ok_or(fmt::Error)?;
-            self.buf
-                .get_mut(self.len..end)
-                .ok_or(fmt::Error)?
-                .copy_from_slice(s.as_bytes());
-            self.len = end;
-            Ok(())
-        }
-    }
 }
