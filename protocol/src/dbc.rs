@@ -7,13 +7,13 @@
 
 use core::fmt::{self, Write};
 
-/// A signal name, built on the stack (no heap in this crate).
-type Name = heapless::String<64>;
-
 use crate::e2e::HEADER_LEN;
 use crate::id::MessageId;
 use crate::node::NodeId;
 use crate::signal::Field;
+
+/// A signal name, built on the stack (no heap in this crate).
+type Name = heapless::String<64>;
 
 /// Writes the whole DBC file.
 pub fn write_dbc<W: Write>(out: &mut W) -> fmt::Result {

@@ -12,7 +12,8 @@ use crate::units::EStopAction;
 pub struct Accepted {
     /// The message.
     pub message: AnyMessage,
-    /// Its E2E status: `Ok`, `OkSomeLost` or `Initial`.
+    /// Its E2E status: `Ok`, `OkSomeLost` or `Initial`; for an E-stop latch also `Repeated` or
+    /// `WrongSequence` (see [`Receiver`]: a latch acts whatever its counter).
     pub status: E2eStatus,
 }
 
