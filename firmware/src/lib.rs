@@ -2,11 +2,21 @@
 //!
 //! Sans-IO: the core takes decoded CAN messages and the tick, and returns actuator commands and
 //! telemetry. It never touches a socket, a clock or a file, so the same code runs in host tests,
-//! in the host firmware process next to the simulator, and on the Cortex-M4F.
+//! in the host firmware process next to the simulator, and on the Cortex-M4F. No heap, no
+//! `f64`, integer time, bounded loops; clippy denies `unwrap`, `expect`, `panic` and unchecked
+//! indexing.
 //!
-//! The kinematics, gait, FSM, balance and safety modules arrive with the control-core issue;
-//! this crate already builds for the host and for `thumbv7em-none-eabihf`.
+//! | layer | module | what it does |
+//! |---|---|---|
+//! | CAN node | [`node`] | frames in (decode, E2E, counted rejects), frames out on the bus schedule |
+//! | control step | [`controller`] | supervisor → FSM → leg goals + smoothing → wheel law → clamps |
+//! | modes | [`fsm`] | states, events and the transition table |
+//! | legs | [`kinematics`], [`posture`], [`gait`], [`foot_trajectory`], [`sine_gait`], [`phase`], [`smoothing`] | IK/FK, stance and fold, the trot |
+//! | wheels | [`balance`], [`wheel`] | LQR balance on IMU pitch, turn speed loop, torque mixing |
+//! | safety | [`safety`], [`sensors`], [`teleop`] | watchdogs, clamps, operator requests |
+//! | basics | [`config`], [`limits`], [`math`], [`time`], [`attitude`] | parameters, units, maths choices |
 #![no_std]
+#![deny(missing_docs)]
 #![deny(
     clippy::unwrap_used,
     clippy::expect_used,
@@ -16,3 +26,29 @@
 )]
 
 pub use protocol;
+
+pub mod attitude;
+pub mod balance;
+pub mod config;
+pub mod controller;
+pub mod foot_trajectory;
+pub mod fsm;
+pub mod gait;
+pub mod kinematics;
+pub mod limits;
+pub mod math;
+pub mod node;
+pub mod phase;
+pub mod posture;
+pub mod safety;
+pub mod sensors;
+pub mod sine_gait;
+pub mod smoothing;
+pub mod teleop;
+pub mod time;
+pub mod wheel;
+
+pub use config::Config;
+pub use controller::{Controller, Output, Status};
+pub use node::Node;
+pub use time::{Tick, TickRate};

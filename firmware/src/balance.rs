@@ -1,0 +1,200 @@
+//! Balance on two coaxial wheels: the robot with its legs folded is a wheeled inverted
+//! pendulum (as Ascento, Upkie and TITA are), kept upright by full-state feedback.
+//!
+//! # Model and derivation
+//!
+//! Planar, linearised about upright. States `x = [p, θ, v, θ̇]`: position error along the
+//! ground `p` (m, the integral of the speed error), body pitch `θ` (rad, positive = leaning
+//! forward, IMU about +y), ground speed error `v` (m/s) and pitch rate `θ̇` (rad/s). Input `τ`:
+//! the sum of both wheel torques (N·m), which acts on the wheels and reacts on the body. With
+//! body mass `M` at height `l` above the axle, body pitch inertia `I_b` about its centre of
+//! mass, wheel mass `m_w`, wheel inertia `I_w` (both wheels) and radius `r`, Lagrange's
+//! equations linearised at θ = 0 give
+//!
+//! ```text
+//! (M + m_w + I_w/r²) ẍ + M l θ̈        = τ / r
+//!  M l ẍ              + (I_b + M l²) θ̈ − M g l θ = −τ
+//! ```
+//!
+//! The gains `K` of `τ = −K x` solve the discrete LQR problem for this model at the control
+//! rate, with Bryson weights (p 0.2 m, θ 0.1 rad, v 0.5 m/s, θ̇ 1 rad/s, τ 30 N·m). The
+//! design lives in `firmware/tests/balance_lqr.rs` (host, `nalgebra`): it recomputes `K` from
+//! [`BalanceModel::ROBOT`], fails if [`BalanceGains::ROBOT`] is stale and prints the new gains,
+//! and checks the closed loop on the linear model.
+//!
+//! The ground speed comes from the wheels: their joint rate is relative to the body, so the
+//! wheel's rate over ground is the joint rate plus the body's pitch rate, `v = r (ω + θ̇)`.
+
+/// Physical parameters of the pendulum (SI units).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BalanceModel {
+    /// Everything but the wheels, kg.
+    pub body_mass_kg: f32,
+    /// Centre of mass of the body above the wheel axle, m.
+    pub com_height_m: f32,
+    /// Body pitch inertia about its centre of mass, kg·m².
+    pub body_pitch_inertia_kg_m2: f32,
+    /// Both wheels, kg.
+    pub wheel_mass_kg: f32,
+    /// Both wheels about the axle, kg·m².
+    pub wheel_inertia_kg_m2: f32,
+    /// Wheel radius, m.
+    pub wheel_radius_m: f32,
+}
+
+impl BalanceModel {
+    /// The robot at the report's density 600 kg/m³, legs folded: torso box 0.6 × 0.5 × 0.18 m
+    /// (32.4 kg, centre 0.15 m above the axle) plus four legs of capsules and a sphere foot
+    /// (≈ 0.85 kg each, near the hips); wheels r = 0.12 m, width 0.09 m (2.44 kg each).
+    pub const ROBOT: Self = Self {
+        body_mass_kg: 35.8,
+        com_height_m: 0.147,
+        body_pitch_inertia_kg_m2: 1.5,
+        wheel_mass_kg: 4.886,
+        wheel_inertia_kg_m2: 0.0352,
+        wheel_radius_m: 0.12,
+    };
+}
+
+/// State-feedback gains, `τ = −(k·x)` in N·m.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BalanceGains {
+    /// N·m per m of position error.
+    pub position_nm_per_m: f32,
+    /// N·m per rad of pitch.
+    pub pitch_nm_per_rad: f32,
+    /// N·m per m/s of speed error.
+    pub velocity_nm_per_m_s: f32,
+    /// N·m per rad/s of pitch rate.
+    pub pitch_rate_nm_per_rad_s: f32,
+}
+
+impl BalanceGains {
+    /// LQR gains for [`BalanceModel::ROBOT`] at 250 Hz (see the module docs).
+    pub const ROBOT: Self = Self {
+        position_nm_per_m: -134.6791,
+        pitch_nm_per_rad: -443.5006,
+        velocity_nm_per_m_s: -160.1927,
+        pitch_rate_nm_per_rad_s: -84.5932,
+    };
+
+    /// As an array `[p, θ, v, θ̇]`.
+    pub const fn to_array(self) -> [f32; 4] {
+        [
+            self.position_nm_per_m,
+            self.pitch_nm_per_rad,
+            self.velocity_nm_per_m_s,
+            self.pitch_rate_nm_per_rad_s,
+        ]
+    }
+}
+
+/// Limits and trims of the balance law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BalanceConfig {
+    /// Gains.
+    pub gains: BalanceGains,
+    /// Wheel radius, m.
+    pub wheel_radius_m: f32,
+    /// Total torque of both wheels, N·m (symmetric).
+    pub torque_limit_nm: f32,
+    /// Bound on the position error the law remembers, m.
+    pub position_error_limit_m: f32,
+    /// Pitch at which the body's centre of mass is over the axle, rad (a fold pose that puts
+    /// mass behind the hips needs a forward lean).
+    pub pitch_trim_rad: f32,
+    /// The speed reference follows a request at most this fast, m/s²: a step in speed would
+    /// throw the pendulum over by the lean it needs to accelerate.
+    pub accel_limit_m_s2: f32,
+}
+
+/// What the balance law reads each tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BalanceInput {
+    /// Body pitch, rad, positive leaning forward.
+    pub pitch_rad: f32,
+    /// Body pitch rate, rad/s.
+    pub pitch_rate_rad_s: f32,
+    /// Mean wheel joint rate (relative to the body), rad/s, positive rolling forward.
+    pub wheel_rate_rad_s: f32,
+    /// Wanted ground speed, m/s (reached through the acceleration limit).
+    pub velocity_ref_m_s: f32,
+}
+
+/// The running balance law.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Balance {
+    config: BalanceConfig,
+    position_error_m: f32,
+    velocity_ref_m_s: f32,
+}
+
+impl Balance {
+    /// At rest, no remembered position error.
+    pub const fn new(config: BalanceConfig) -> Self {
+        Self {
+            config,
+            position_error_m: 0.0,
+            velocity_ref_m_s: 0.0,
+        }
+    }
+
+    /// Forgets the position error (when the wheels take over).
+    pub fn reset(&mut self) {
+        self.position_error_m = 0.0;
+        self.velocity_ref_m_s = 0.0;
+    }
+
+    /// The speed reference after the acceleration limit, m/s.
+    pub fn velocity_ref_m_s(&self) -> f32 {
+        self.velocity_ref_m_s
+    }
+
+    /// The remembered position error, m.
+    pub fn position_error_m(&self) -> f32 {
+        self.position_error_m
+    }
+
+    /// The ground speed the wheels report, m/s.
+    pub fn ground_speed_m_s(&self, input: &BalanceInput) -> f32 {
+        self.config.wheel_radius_m * (input.wheel_rate_rad_s + input.pitch_rate_rad_s)
+    }
+
+    /// One tick of `dt_s`: the total wheel torque, N·m, within ±`torque_limit_nm`. Any
+    /// non-finite input gives zero torque and leaves the state untouched.
+    pub fn update(&mut self, input: &BalanceInput, dt_s: f32) -> f32 {
+        let step = self.config.accel_limit_m_s2 * dt_s;
+        let velocity_ref = self.velocity_ref_m_s
+            + crate::math::clamp(input.velocity_ref_m_s - self.velocity_ref_m_s, -step, step);
+        let speed_error = self.ground_speed_m_s(input) - velocity_ref;
+        let pitch = input.pitch_rad - self.config.pitch_trim_rad;
+        if !(speed_error.is_finite()
+            && velocity_ref.is_finite()
+            && pitch.is_finite()
+            && input.pitch_rate_rad_s.is_finite())
+        {
+            return 0.0;
+        }
+        self.velocity_ref_m_s = velocity_ref;
+        let k = self.config.gains;
+        let limit = self.config.torque_limit_nm;
+        let torque_at = |position_error_m: f32| {
+            -(k.position_nm_per_m * position_error_m
+                + k.pitch_nm_per_rad * pitch
+                + k.velocity_nm_per_m_s * speed_error
+                + k.pitch_rate_nm_per_rad_s * input.pitch_rate_rad_s)
+        };
+        let bound = self.config.position_error_limit_m;
+        let candidate =
+            crate::math::clamp(self.position_error_m + speed_error * dt_s, -bound, bound);
+        let unclamped = torque_at(candidate);
+        // Anti-windup: while the torque saturates, keep the position error only if it does
+        // not push the torque further past the limit.
+        let saturated = unclamped.abs() > limit;
+        let grows = torque_at(candidate).abs() > torque_at(self.position_error_m).abs();
+        if !(saturated && grows) {
+            self.position_error_m = candidate;
+        }
+        crate::math::clamp(torque_at(self.position_error_m), -limit, limit)
+    }
+}

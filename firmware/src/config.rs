@@ -1,0 +1,85 @@
+//! Every tunable of the controller in one value, with the report's numbers as defaults.
+
+use crate::balance::{BalanceConfig, BalanceGains, BalanceModel};
+use crate::gait::TrotParams;
+use crate::kinematics::LegGeometry;
+use crate::limits::JointLimits;
+use crate::posture::Posture;
+use crate::smoothing::Smoother;
+use crate::time::TickRate;
+use crate::wheel::SpeedLoopGains;
+
+/// Controller configuration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Config {
+    /// Control rate.
+    pub rate: TickRate,
+    /// Leg links.
+    pub geometry: LegGeometry,
+    /// Joint ranges.
+    pub limits: JointLimits,
+    /// Fold and stance poses.
+    pub posture: Posture,
+    /// Trot.
+    pub trot: TrotParams,
+    /// Leg smoothing rate, 1/s (the report's 8).
+    pub leg_rate_per_s: f32,
+    /// Fold smoothing rate, 1/s (the report's 6).
+    pub fold_rate_per_s: f32,
+    /// A transition ends when every smoothed target is this close to its pose, rad.
+    pub pose_tolerance_rad: f32,
+    /// Wheel speed of W/S and of each wheel in A (the report's 4 rad/s).
+    pub wheel_speed_rad_s: f32,
+    /// Per-wheel torque limit, N·m.
+    pub wheel_torque_limit_nm: f32,
+    /// Turn (differential) speed loop.
+    pub turn: SpeedLoopGains,
+    /// Balance law.
+    pub balance: BalanceConfig,
+    /// Leg or wheel feedback older than this stops the robot, ms.
+    pub feedback_timeout_ms: u32,
+    /// IMU samples older than this stop a balancing robot, ms.
+    pub imu_timeout_ms: u32,
+    /// An operator silent this long is treated as a stop request, ms.
+    pub teleop_timeout_ms: u32,
+    /// Pitch or roll beyond this is a fall: fault, rad.
+    pub tilt_limit_rad: f32,
+}
+
+/// Per-wheel torque limit of the robot, N·m.
+const WHEEL_TORQUE_LIMIT_NM: f32 = 30.0;
+
+impl Config {
+    /// The robot at 250 Hz (one tick per simulator step of 0.004 s).
+    pub const ROBOT: Self = Self {
+        rate: TickRate::SIM_250_HZ,
+        geometry: LegGeometry::ROBOT,
+        limits: JointLimits::REPORT,
+        posture: Posture::ROBOT,
+        trot: TrotParams::DEFAULT,
+        leg_rate_per_s: Smoother::LEG_RATE_PER_S,
+        fold_rate_per_s: Smoother::FOLD_RATE_PER_S,
+        pose_tolerance_rad: 0.01,
+        wheel_speed_rad_s: 4.0,
+        wheel_torque_limit_nm: WHEEL_TORQUE_LIMIT_NM,
+        turn: SpeedLoopGains::TURN,
+        balance: BalanceConfig {
+            gains: BalanceGains::ROBOT,
+            wheel_radius_m: BalanceModel::ROBOT.wheel_radius_m,
+            torque_limit_nm: 2.0 * WHEEL_TORQUE_LIMIT_NM,
+            position_error_limit_m: 0.3,
+            pitch_trim_rad: 0.0,
+            accel_limit_m_s2: 1.5,
+        },
+        feedback_timeout_ms: 50,
+        imu_timeout_ms: 50,
+        teleop_timeout_ms: 500,
+        tilt_limit_rad: 45.0 * (core::f32::consts::PI / 180.0),
+    };
+
+    /// This configuration at another control rate (gains are per second, so only the tick
+    /// arithmetic changes).
+    pub const fn at_rate(self, rate: TickRate) -> Self {
+        Self { rate, ..self }
+    }
+}

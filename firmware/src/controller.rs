@@ -1,0 +1,405 @@
+//! The control step: decoded messages in, actuator commands and status out. Sans-IO — the
+//! caller owns the clock and the bus and hands in the tick.
+//!
+//! Each tick ([`Controller::step`]):
+//! 1. the supervisor checks the watchdogs and the tilt and raises faults;
+//! 2. a running transition that has arrived fires `PoseReached`;
+//! 3. the state picks the legs' goal pose (hold, stance, trot, fold) and the wheels' law
+//!    (balance + turn loop, or nothing);
+//! 4. the legs' targets move toward the goal with the report's smoothing;
+//! 5. every output is clamped to the joint and torque limits and made finite.
+
+use protocol::{AnyMessage, ControllerMode, DriveFlags, EStopAction, FaultFlags};
+
+use crate::balance::{Balance, BalanceInput};
+use crate::config::Config;
+use crate::fsm::{Direction, Event, LegMotion, State, WheelMotion};
+use crate::gait::Trot;
+use crate::kinematics::LegJoints;
+use crate::safety::{clamp_leg_targets, clamp_wheel_torques};
+use crate::sensors::Sensors;
+use crate::smoothing::Smoother;
+use crate::teleop::Teleop;
+use crate::time::Tick;
+use crate::wheel::{mix, SpeedLoop};
+
+/// What the controller commands this tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Output {
+    /// Whether the leg drives should servo (false: torque-free).
+    pub legs_enabled: bool,
+    /// Leg joint targets, wire order, rad; within the joint ranges and finite.
+    pub leg_targets_rad: [f32; 16],
+    /// Wheel torques (left, right), N·m; within the torque limit and finite.
+    pub wheel_torque_nm: [f32; 2],
+    /// Telemetry.
+    pub status: Status,
+}
+
+/// The controller's telemetry.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Status {
+    /// Reported mode.
+    pub mode: ControllerMode,
+    /// Active fault causes.
+    pub faults: FaultFlags,
+    /// The tick of this output.
+    pub tick: Tick,
+    /// Body-height offset the legs realise, m.
+    pub body_height_m: f32,
+    /// Torso pitch, rad.
+    pub pitch_rad: f32,
+    /// Torso roll, rad.
+    pub roll_rad: f32,
+    /// IK solutions that failed and were replaced by the previous target (since power-on).
+    pub ik_failures: u32,
+}
+
+/// Why [`Controller::new`] refused a configuration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum ConfigError {
+    /// The trot frequency is zero or not below the control rate.
+    TrotFrequency,
+}
+
+/// The robot's controller.
+#[derive(Debug, Clone)]
+pub struct Controller {
+    config: Config,
+    state: State,
+    sensors: Sensors,
+    teleop: Teleop,
+    trot: Trot,
+    balance: Balance,
+    turn: SpeedLoop,
+    /// Smoothed leg targets, wire order.
+    legs_rad: [f32; 16],
+    /// Goal of the smoothing, wire order (kept so a failed IK holds the previous goal).
+    goal_rad: [f32; 16],
+    /// Whether the drives have reported positions so the targets start from them.
+    armed: bool,
+    drive_fault: bool,
+    tilted: bool,
+    non_finite: bool,
+    ik_failures: u32,
+}
+
+impl Controller {
+    /// A controller in [`State::Hold`] with drives torque-free until every drive has reported.
+    pub fn new(config: Config) -> Result<Self, ConfigError> {
+        let rate = config.rate;
+        let trot = Trot::new(config.trot, rate).ok_or(ConfigError::TrotFrequency)?;
+        Ok(Self {
+            config,
+            state: State::INITIAL,
+            sensors: Sensors::new(
+                rate.ticks_from_ms(config.feedback_timeout_ms),
+                rate.ticks_from_ms(config.imu_timeout_ms),
+            ),
+            teleop: Teleop::new(rate.ticks_from_ms(config.teleop_timeout_ms)),
+            trot,
+            balance: Balance::new(config.balance),
+            turn: SpeedLoop::new(config.turn),
+            legs_rad: [0.0; 16],
+            goal_rad: [0.0; 16],
+            armed: false,
+            drive_fault: false,
+            tilted: false,
+            non_finite: false,
+            ik_failures: 0,
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &Config {
+        &self.config
+    }
+
+    /// The present state.
+    pub fn state(&self) -> State {
+        self.state
+    }
+
+    /// The latest sensor values.
+    pub fn sensors(&self) -> &Sensors {
+        &self.sensors
+    }
+
+    /// The trot generator (its phase).
+    pub fn trot(&self) -> &Trot {
+        &self.trot
+    }
+
+    /// Takes one accepted message received at `now`. Messages the controller does not consume
+    /// (its own commands echoed, other nodes' status) are ignored.
+    pub fn on_message(&mut self, now: Tick, message: &AnyMessage) {
+        match message {
+            AnyMessage::EStop(estop) => match estop.action {
+                EStopAction::Latch => self.apply(Event::EStopLatch),
+                EStopAction::Clear => self.apply(Event::EStopClear),
+            },
+            AnyMessage::LegFeedback(leg, feedback) => self.sensors.record_leg(now, *leg, feedback),
+            AnyMessage::WheelFeedback(feedback) => self.sensors.record_wheels(now, feedback),
+            AnyMessage::Imu(imu) => self.sensors.record_imu(now, imu),
+            AnyMessage::TeleopHeartbeat(_) => self.teleop.heartbeat(now),
+            AnyMessage::TeleopCommand(command) => {
+                if let Some(mode) = self.teleop.command(now, command) {
+                    if self.state == State::Fault && mode == protocol::TeleopMode::Stop {
+                        if self.fault_causes(now).is_empty() {
+                            self.apply(Event::Reset);
+                        }
+                    } else {
+                        self.apply(Event::Request(mode));
+                    }
+                }
+            }
+            AnyMessage::DriveStatus(_, status) => {
+                if status.flags.contains(DriveFlags::FAULT) {
+                    self.drive_fault = true;
+                    self.apply(Event::Fault);
+                }
+            }
+            AnyMessage::Sync(_)
+            | AnyMessage::LegTargets(_)
+            | AnyMessage::WheelCommand(_)
+            | AnyMessage::ControllerStatus(_)
+            | AnyMessage::RejectCounters(_) => {}
+        }
+    }
+
+    /// Runs one control tick at `now`.
+    pub fn step(&mut self, now: Tick) -> Output {
+        self.supervise(now);
+        if !self.armed {
+            self.legs_rad = self.sensors.joint_position_rad;
+            self.goal_rad = self.legs_rad;
+        }
+        let dt_s = self.config.rate.period_s();
+        let depth_m = self.config.posture.depth_for(self.teleop.body_height_m);
+        let previous = self.legs_rad;
+        let mut wheel_torque_nm = [0.0; 2];
+        let mut legs_enabled = self.armed;
+        match self.state {
+            State::EStop => {
+                legs_enabled = false;
+                self.legs_rad = self.sensors.joint_position_rad;
+                self.goal_rad = self.legs_rad;
+            }
+            State::Hold | State::Fault => {}
+            State::Legs(motion) | State::Standing(motion) => {
+                self.leg_goal(motion, depth_m);
+                self.smooth(self.config.leg_rate_per_s);
+            }
+            State::Folding(_) | State::Wheels(_) => {
+                self.goal_rad = fold_goal(&self.config);
+                self.smooth(self.config.fold_rate_per_s);
+            }
+        }
+        if self.state.balancing() && self.armed {
+            wheel_torque_nm = self.wheel_law(now, dt_s);
+        } else {
+            self.balance.reset();
+            self.turn.reset();
+        }
+        if matches!(self.state, State::Legs(LegMotion::Trot(_))) {
+            self.trot.advance();
+        }
+        let mut leg_targets_rad = self.legs_rad;
+        let legs_bad = clamp_leg_targets(&self.config.limits, &mut leg_targets_rad, &previous);
+        let wheels_bad =
+            clamp_wheel_torques(self.config.wheel_torque_limit_nm, &mut wheel_torque_nm);
+        self.non_finite = legs_bad || wheels_bad;
+        self.legs_rad = leg_targets_rad;
+        if self.transition_arrived() {
+            self.apply(Event::PoseReached);
+        }
+        Output {
+            legs_enabled,
+            leg_targets_rad,
+            wheel_torque_nm,
+            status: self.status(now, depth_m),
+        }
+    }
+
+    fn status(&self, now: Tick, depth_m: f32) -> Status {
+        let mut faults = self.fault_causes(now);
+        if self.state == State::EStop {
+            faults = faults.with(FaultFlags::ESTOP_LATCHED);
+        }
+        if self.teleop.stale(now) {
+            faults = faults.with(FaultFlags::TELEOP_TIMEOUT);
+        }
+        if self.non_finite {
+            faults = faults.with(FaultFlags::NON_FINITE);
+        }
+        let attitude = self.sensors.attitude;
+        Status {
+            mode: self.state.mode(),
+            faults,
+            tick: now,
+            body_height_m: depth_m - self.config.posture.depth_nominal_m,
+            pitch_rad: attitude.pitch_rad,
+            roll_rad: attitude.roll_rad,
+            ik_failures: self.ik_failures,
+        }
+    }
+
+    /// Causes that keep (or would put) the robot in `Fault`.
+    fn fault_causes(&self, now: Tick) -> FaultFlags {
+        let mut faults = FaultFlags::EMPTY;
+        if self.sensors.drives_stale(now) {
+            faults = faults.with(FaultFlags::FEEDBACK_TIMEOUT);
+        }
+        if self.sensors.imu_stale(now) {
+            faults = faults.with(FaultFlags::IMU_TIMEOUT);
+        }
+        if self.tilted {
+            faults = faults.with(FaultFlags::TILT_LIMIT);
+        }
+        if self.drive_fault {
+            faults = faults.with(FaultFlags::DRIVE_FAULT);
+        }
+        faults
+    }
+
+    fn supervise(&mut self, now: Tick) {
+        if !self.armed && self.sensors.drives_ever_reported() && !self.sensors.drives_stale(now) {
+            self.armed = true;
+            self.legs_rad = self.sensors.joint_position_rad;
+            self.goal_rad = self.legs_rad;
+        }
+        let imu_stale = self.sensors.imu_stale(now);
+        self.tilted = !imu_stale && self.sensors.attitude.tilt_rad() > self.config.tilt_limit_rad;
+        if self.teleop.just_lost(now) {
+            self.apply(Event::TeleopLost);
+        }
+        if !self.armed || matches!(self.state, State::EStop | State::Fault) {
+            return;
+        }
+        let moving = !matches!(self.state, State::Hold);
+        if self.sensors.drives_stale(now)
+            || (imu_stale && self.state.balancing())
+            || (self.tilted && moving)
+        {
+            self.apply(Event::Fault);
+        }
+    }
+
+    /// Whether a running transition has brought every target to its pose (checked after
+    /// this tick's goal and smoothing, so the next tick runs the new state).
+    fn transition_arrived(&self) -> bool {
+        matches!(self.state, State::Standing(_) | State::Folding(_))
+            && self.armed
+            && self
+                .legs_rad
+                .iter()
+                .zip(&self.goal_rad)
+                .all(|(now, goal)| (goal - now).abs() <= self.config.pose_tolerance_rad)
+    }
+
+    fn apply(&mut self, event: Event) {
+        let next = self.state.next(event);
+        if next == self.state {
+            return;
+        }
+        let entering_trot = matches!(next, State::Legs(LegMotion::Trot(_)))
+            && !matches!(self.state, State::Legs(LegMotion::Trot(_)));
+        if entering_trot {
+            self.trot.restart();
+        }
+        if next == State::Hold {
+            self.drive_fault = false;
+            self.legs_rad = if self.armed {
+                self.sensors.joint_position_rad
+            } else {
+                self.legs_rad
+            };
+            self.goal_rad = self.legs_rad;
+        }
+        self.state = next;
+    }
+
+    fn leg_goal(&mut self, motion: LegMotion, depth_m: f32) {
+        let config = &self.config;
+        let goals: [Result<LegJoints, _>; 4] = match (motion, self.state) {
+            (LegMotion::Trot(direction), State::Legs(_)) => self.trot.targets(
+                direction,
+                depth_m,
+                self.teleop.speed_scale,
+                &config.geometry,
+                &config.limits,
+                &config.posture,
+            ),
+            _ => {
+                [config
+                    .posture
+                    .stance(&config.geometry, &config.limits, depth_m); 4]
+            }
+        };
+        for (goal, slot) in goals.iter().zip(self.goal_rad.chunks_exact_mut(4)) {
+            match goal {
+                Ok(joints) => slot.copy_from_slice(&joints.to_array()),
+                Err(_) => self.ik_failures = self.ik_failures.saturating_add(1),
+            }
+        }
+    }
+
+    fn smooth(&mut self, rate_per_s: f32) {
+        let smoother = Smoother::new(rate_per_s, self.config.rate);
+        for (target, goal) in self.legs_rad.iter_mut().zip(&self.goal_rad) {
+            *target = smoother.step(*target, *goal);
+        }
+    }
+
+    fn wheel_law(&mut self, now: Tick, dt_s: f32) -> [f32; 2] {
+        if self.sensors.imu_stale(now) {
+            return [0.0; 2];
+        }
+        let config = &self.config;
+        let speed = config.wheel_speed_rad_s * self.teleop.speed_scale;
+        let (velocity_ref_m_s, turn_ref_rad_s) = match self.state {
+            State::Wheels(WheelMotion::Drive(Direction::Forward)) => {
+                (speed * config.balance.wheel_radius_m, 0.0)
+            }
+            State::Wheels(WheelMotion::Drive(Direction::Backward)) => {
+                (-speed * config.balance.wheel_radius_m, 0.0)
+            }
+            State::Wheels(WheelMotion::Rotate) => (0.0, speed),
+            _ => (0.0, 0.0),
+        };
+        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        let common = self.balance.update(
+            &BalanceInput {
+                pitch_rad: self.sensors.attitude.pitch_rad,
+                pitch_rate_rad_s,
+                wheel_rate_rad_s: self.sensors.mean_wheel_rate_rad_s(),
+                velocity_ref_m_s,
+            },
+            dt_s,
+        );
+        let differential = self.turn.update(
+            turn_ref_rad_s - self.sensors.differential_wheel_rate_rad_s(),
+            dt_s,
+        );
+        let (left, right) = mix(common, differential, config.wheel_torque_limit_nm);
+        [left, right]
+    }
+}
+
+/// The fold pose for all four legs, clamped into the joint ranges.
+fn fold_goal(config: &Config) -> [f32; 16] {
+    let mut goal = repeat(config.posture.fold);
+    let fallback = goal;
+    clamp_leg_targets(&config.limits, &mut goal, &fallback);
+    goal
+}
+
+fn repeat(joints: LegJoints) -> [f32; 16] {
+    let one = joints.to_array();
+    let mut all = [0.0; 16];
+    for chunk in all.chunks_exact_mut(4) {
+        chunk.copy_from_slice(&one);
+    }
+    all
+}

@@ -1,0 +1,189 @@
+//! The mode machine: what the robot is doing, and what every request does in every state.
+//!
+//! The report's six keys pick a motion; a real robot also has to change how it stands between
+//! them. The legs fold before the wheels drive (`Folding`), the legs take the weight before a
+//! trot (`Standing`), and the two stop states (`EStop`, `Fault`) hold until someone acts.
+//!
+//! # Transition table
+//!
+//! `Request(·)` is an operator request (teleop frame). `Legs(m)` and `Wheels(m)` are the
+//! steady states, `Standing(m)` / `Folding(m)` the transitions that end in them on `PoseReached`.
+//! `—` means the event leaves the state unchanged.
+//!
+//! | state ↓ / event →  | Stop (X), `TeleopLost` | Stand          | Trot d (L/K)      | Fold             | Wheel w (W/S/A)   | `PoseReached` |
+//! |--------------------|------------------------|----------------|-------------------|------------------|-------------------|---------------|
+//! | `Hold`             | —                      | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | —             |
+//! | `Legs(_)`          | Legs(Stand)            | Legs(Stand)    | Legs(Trot d)      | Folding(Balance) | Folding(w)        | —             |
+//! | `Standing(_)`      | Standing(Stand)        | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Legs(m)       |
+//! | `Folding(_)`       | Folding(Balance)       | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Wheels(m)     |
+//! | `Wheels(_)`        | Wheels(Balance)        | Standing(Stand)| Standing(Trot d)  | —                | Wheels(w)         | —             |
+//! | `EStop`            | —                      | —              | —                 | —                | —                 | —             |
+//! | `Fault`            | —                      | —              | —                 | —                | —                 | —             |
+//!
+//! Events that reach every state alike:
+//!
+//! | event         | result                                                                     |
+//! |---------------|----------------------------------------------------------------------------|
+//! | `EStopLatch`  | `EStop` from any state                                                     |
+//! | `EStopClear`  | `EStop` → `Hold`; no effect elsewhere                                      |
+//! | `Fault`       | `Fault` from any state but `EStop` (an E-stop outranks a fault)            |
+//! | `Reset`       | `Fault` → `Hold` (sent when the operator asks to stop and no cause remains); no effect elsewhere |
+//!
+//! `Hold` is where the robot starts and where it returns after a clear or a reset: the drives
+//! hold their present positions and nothing moves until the operator asks for a motion.
+
+use protocol::{ControllerMode, TeleopMode};
+
+/// Which way a trot or a wheel drive goes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Direction {
+    /// +x.
+    Forward,
+    /// −x.
+    Backward,
+}
+
+/// What the legs do while they carry the robot.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LegMotion {
+    /// Stand still at the commanded body height.
+    Stand,
+    /// Trot (diagonal pairs).
+    Trot(Direction),
+}
+
+/// What the wheels do while they carry the robot (always balancing).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum WheelMotion {
+    /// Balance in place.
+    Balance,
+    /// Drive straight.
+    Drive(Direction),
+    /// Turn in place (differential drive).
+    Rotate,
+}
+
+/// The controller's state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum State {
+    /// Drives hold their positions; nothing moves until a request.
+    Hold,
+    /// On the legs.
+    Legs(LegMotion),
+    /// Unfolding onto the legs; then the motion.
+    Standing(LegMotion),
+    /// Folding onto the wheels; then the motion.
+    Folding(WheelMotion),
+    /// Balancing on the wheels.
+    Wheels(WheelMotion),
+    /// Emergency stop: drives torque-free until [`Event::EStopClear`].
+    EStop,
+    /// A fault stopped the robot until [`Event::Reset`].
+    Fault,
+}
+
+/// Something that can change the state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Event {
+    /// The operator asked for a mode.
+    Request(TeleopMode),
+    /// The operator's heartbeat stopped: treated as a stop request.
+    TeleopLost,
+    /// The legs arrived at the pose of the running transition.
+    PoseReached,
+    /// An E-stop frame asked to latch.
+    EStopLatch,
+    /// An E-stop frame asked to clear.
+    EStopClear,
+    /// The safety supervisor found a fault.
+    Fault,
+    /// The operator asked to stop and no fault cause remains.
+    Reset,
+}
+
+impl State {
+    /// Power-on state.
+    pub const INITIAL: State = State::Hold;
+
+    /// The state after `event`. Total: every event has a result in every state.
+    pub fn next(self, event: Event) -> State {
+        match (self, event) {
+            (_, Event::EStopLatch) => State::EStop,
+            (State::EStop, Event::EStopClear) => State::Hold,
+            (State::EStop, _) => State::EStop,
+            (_, Event::Fault) => State::Fault,
+            (State::Fault, Event::Reset) => State::Hold,
+            (State::Fault, _) => State::Fault,
+            (_, Event::EStopClear | Event::Reset) => self,
+            (State::Standing(motion), Event::PoseReached) => State::Legs(motion),
+            (State::Folding(motion), Event::PoseReached) => State::Wheels(motion),
+            (_, Event::PoseReached) => self,
+            (_, Event::TeleopLost) => self.on_request(TeleopMode::Stop),
+            (_, Event::Request(mode)) => self.on_request(mode),
+        }
+    }
+
+    fn on_request(self, mode: TeleopMode) -> State {
+        let on_wheels = matches!(self, State::Folding(_) | State::Wheels(_));
+        match mode {
+            TeleopMode::Stop => match self {
+                State::Legs(_) => State::Legs(LegMotion::Stand),
+                State::Standing(_) => State::Standing(LegMotion::Stand),
+                State::Folding(_) => State::Folding(WheelMotion::Balance),
+                State::Wheels(_) => State::Wheels(WheelMotion::Balance),
+                other => other,
+            },
+            TeleopMode::Stand => self.to_legs(LegMotion::Stand),
+            TeleopMode::TrotForward => self.to_legs(LegMotion::Trot(Direction::Forward)),
+            TeleopMode::TrotBackward => self.to_legs(LegMotion::Trot(Direction::Backward)),
+            TeleopMode::Fold if on_wheels => match self {
+                State::Folding(_) => State::Folding(WheelMotion::Balance),
+                other => other,
+            },
+            TeleopMode::Fold => State::Folding(WheelMotion::Balance),
+            TeleopMode::WheelForward => self.to_wheels(WheelMotion::Drive(Direction::Forward)),
+            TeleopMode::WheelBackward => self.to_wheels(WheelMotion::Drive(Direction::Backward)),
+            TeleopMode::WheelRotate => self.to_wheels(WheelMotion::Rotate),
+        }
+    }
+
+    fn to_legs(self, motion: LegMotion) -> State {
+        match self {
+            State::Legs(_) => State::Legs(motion),
+            _ => State::Standing(motion),
+        }
+    }
+
+    fn to_wheels(self, motion: WheelMotion) -> State {
+        match self {
+            State::Wheels(_) => State::Wheels(motion),
+            _ => State::Folding(motion),
+        }
+    }
+
+    /// The mode reported on the bus.
+    pub fn mode(self) -> ControllerMode {
+        match self {
+            State::Hold | State::Legs(LegMotion::Stand) | State::Wheels(WheelMotion::Balance) => {
+                ControllerMode::Stop
+            }
+            State::Legs(LegMotion::Trot(Direction::Forward)) => ControllerMode::TrotForward,
+            State::Legs(LegMotion::Trot(Direction::Backward)) => ControllerMode::TrotBackward,
+            State::Standing(_) => ControllerMode::Standing,
+            State::Folding(_) => ControllerMode::Folding,
+            State::Wheels(WheelMotion::Drive(Direction::Forward)) => ControllerMode::WheelForward,
+            State::Wheels(WheelMotion::Drive(Direction::Backward)) => ControllerMode::WheelBackward,
+            State::Wheels(WheelMotion::Rotate) => ControllerMode::WheelRotate,
+            State::EStop => ControllerMode::EStop,
+            State::Fault => ControllerMode::Fault,
+        }
+    }
+
+    /// Whether the wheels carry (or are about to carry) the robot, so the balance law runs.
+    pub fn balancing(self) -> bool {
+        matches!(
+            self,
+            State::Folding(_) | State::Wheels(_) | State::Standing(_)
+        )
+    }
+}

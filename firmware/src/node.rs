@@ -1,0 +1,145 @@
+//! The controller as a CAN node: frames in, frames out, still sans-IO.
+//!
+//! [`Node::on_frame`] runs every received frame through the protocol's
+//! [`Receiver`](protocol::Receiver) — decode, CRC, rolling counter — so that nothing rejected
+//! reaches the controller, and every rejection is counted by cause. [`Node::poll`] runs one
+//! control tick and encodes the frames due in it, following the protocol's bus schedule
+//! ([`protocol::busload::SCHEDULE`]): wheel torques every tick, leg targets at up to 250 Hz,
+//! status at 50 Hz, the reject counters at 10 Hz.
+
+use heapless::Vec;
+use protocol::busload::SCHEDULE;
+use protocol::{
+    Angle, AnyMessage, BodyHeight, ControllerStatus, DecodeError, DriveEnable, E2eCounter, Frame,
+    LegTargets, MessageId, Receiver, RejectCounters, Torque, WheelCommand,
+};
+
+use crate::config::Config;
+use crate::controller::{ConfigError, Controller, Output};
+use crate::time::Tick;
+
+/// Most frames the node sends in one tick.
+pub const MAX_FRAMES_PER_TICK: usize = 4;
+
+/// Frames to put on the bus this tick, highest priority first.
+pub type TickFrames = Vec<Frame, MAX_FRAMES_PER_TICK>;
+
+/// Rolling counters of the frames this node sends.
+#[derive(Debug, Clone, Copy, Default)]
+struct TxCounters {
+    leg_targets: E2eCounter,
+    wheel_command: E2eCounter,
+    status: E2eCounter,
+    reject_counters: E2eCounter,
+}
+
+/// The controller with its receive checks and its transmit schedule.
+#[derive(Debug, Clone)]
+pub struct Node {
+    receiver: Receiver,
+    controller: Controller,
+    tx: TxCounters,
+    encode_failures: u32,
+}
+
+impl Node {
+    /// A node running `config`.
+    pub fn new(config: Config) -> Result<Self, ConfigError> {
+        Ok(Self {
+            receiver: Receiver::default(),
+            controller: Controller::new(config)?,
+            tx: TxCounters::default(),
+            encode_failures: 0,
+        })
+    }
+
+    /// The controller inside.
+    pub fn controller(&self) -> &Controller {
+        &self.controller
+    }
+
+    /// Frames rejected so far, by cause, and frames lost in sequence.
+    pub fn reject_counters(&self) -> &RejectCounters {
+        self.receiver.counters()
+    }
+
+    /// Messages that failed to encode (none should: sizes are checked at compile time).
+    pub fn encode_failures(&self) -> u32 {
+        self.encode_failures
+    }
+
+    /// Takes one received frame. A rejected frame is counted and returned as the error; it
+    /// never reaches the controller.
+    pub fn on_frame(&mut self, now: Tick, raw_id: u16, data: &[u8]) -> Result<(), DecodeError> {
+        let accepted = self.receiver.receive(raw_id, data)?;
+        self.controller.on_message(now, &accepted.message);
+        Ok(())
+    }
+
+    /// Runs one control tick and returns its output and the frames due.
+    pub fn poll(&mut self, now: Tick) -> (Output, TickFrames) {
+        let output = self.controller.step(now);
+        let hz = self.controller.config().rate.hz();
+        let due = |id: MessageId| {
+            SCHEDULE
+                .iter()
+                .find(|slot| slot.id == id)
+                .is_some_and(|slot| slot.sends_in(now.0, hz))
+        };
+        let mut frames = TickFrames::new();
+        if due(MessageId::LegTargets) {
+            let message = AnyMessage::LegTargets(LegTargets {
+                enable: if output.legs_enabled {
+                    DriveEnable::Enabled
+                } else {
+                    DriveEnable::Disabled
+                },
+                position: output.leg_targets_rad.map(Angle::saturating_from_si),
+            });
+            let counter = self.tx.leg_targets.advance();
+            self.push(&mut frames, &message, counter);
+        }
+        if due(MessageId::WheelCommand) {
+            let message = AnyMessage::WheelCommand(WheelCommand {
+                torque: output.wheel_torque_nm.map(Torque::saturating_from_si),
+            });
+            let counter = self.tx.wheel_command.advance();
+            self.push(&mut frames, &message, counter);
+        }
+        if due(MessageId::ControllerStatus) {
+            let status = output.status;
+            let message = AnyMessage::ControllerStatus(ControllerStatus {
+                mode: status.mode,
+                faults: status.faults,
+                tick: wire_tick(status.tick),
+                body_height: BodyHeight::saturating_from_si(status.body_height_m),
+                pitch: Angle::saturating_from_si(status.pitch_rad),
+                roll: Angle::saturating_from_si(status.roll_rad),
+            });
+            let counter = self.tx.status.advance();
+            self.push(&mut frames, &message, counter);
+        }
+        if due(MessageId::RejectCounters) {
+            let message = AnyMessage::RejectCounters(*self.receiver.counters());
+            let counter = self.tx.reject_counters.advance();
+            self.push(&mut frames, &message, counter);
+        }
+        (output, frames)
+    }
+
+    fn push(&mut self, frames: &mut TickFrames, message: &AnyMessage, counter: u16) {
+        match message.encode(counter) {
+            Ok(frame) => {
+                if frames.push(frame).is_err() {
+                    self.encode_failures = self.encode_failures.saturating_add(1);
+                }
+            }
+            Err(_) => self.encode_failures = self.encode_failures.saturating_add(1),
+        }
+    }
+}
+
+/// The tick on the wire: the full `u32` range is valid, so this never saturates.
+fn wire_tick(tick: Tick) -> protocol::Tick {
+    protocol::Tick::from_raw(tick.0).unwrap_or(protocol::Tick::saturating_from_si(0.0))
+}

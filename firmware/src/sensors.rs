@@ -1,0 +1,116 @@
+//! The latest feedback from the drives and the IMU, in SI units, with a watchdog per source.
+
+use protocol::{Imu, Leg, LegFeedback, WheelFeedback};
+
+use crate::attitude::Attitude;
+use crate::safety::Watchdog;
+use crate::time::Tick;
+
+/// The newest samples and how fresh they are.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sensors {
+    /// Joint positions, wire order (4 per leg), rad.
+    pub joint_position_rad: [f32; 16],
+    /// Joint velocities, wire order, rad/s.
+    pub joint_velocity_rad_s: [f32; 16],
+    /// Wheel joint rates (left, right), relative to the body, rad/s.
+    pub wheel_rate_rad_s: [f32; 2],
+    /// Torso attitude.
+    pub attitude: Attitude,
+    /// Body rates about x, y, z, rad/s.
+    pub angular_rate_rad_s: [f32; 3],
+    legs: [Watchdog; 4],
+    wheels: Watchdog,
+    imu: Watchdog,
+}
+
+impl Sensors {
+    /// Nothing received yet; watchdogs of `feedback_ticks` (drives) and `imu_ticks`.
+    pub const fn new(feedback_ticks: u32, imu_ticks: u32) -> Self {
+        Self {
+            joint_position_rad: [0.0; 16],
+            joint_velocity_rad_s: [0.0; 16],
+            wheel_rate_rad_s: [0.0; 2],
+            attitude: Attitude {
+                pitch_rad: 0.0,
+                roll_rad: 0.0,
+            },
+            angular_rate_rad_s: [0.0; 3],
+            legs: [Watchdog::new(feedback_ticks); 4],
+            wheels: Watchdog::new(feedback_ticks),
+            imu: Watchdog::new(imu_ticks),
+        }
+    }
+
+    /// Stores one leg's feedback.
+    pub fn record_leg(&mut self, now: Tick, leg: Leg, feedback: &LegFeedback) {
+        let first = leg_index(leg) * 4;
+        for (joint, (position, velocity)) in
+            feedback.position.iter().zip(&feedback.velocity).enumerate()
+        {
+            if let Some(slot) = self.joint_position_rad.get_mut(first + joint) {
+                *slot = position.si();
+            }
+            if let Some(slot) = self.joint_velocity_rad_s.get_mut(first + joint) {
+                *slot = velocity.si();
+            }
+        }
+        if let Some(watchdog) = self.legs.get_mut(leg_index(leg)) {
+            watchdog.feed(now);
+        }
+    }
+
+    /// Stores the wheel feedback.
+    pub fn record_wheels(&mut self, now: Tick, feedback: &WheelFeedback) {
+        self.wheel_rate_rad_s = feedback.velocity.map(|v| v.si());
+        self.wheels.feed(now);
+    }
+
+    /// Stores an IMU sample. A quaternion that gives no attitude (all zero) does not count as a
+    /// sample.
+    pub fn record_imu(&mut self, now: Tick, imu: &Imu) {
+        let attitude = Attitude::from_quaternion(imu.orientation.map(|q| q.si()));
+        if attitude.tilt_rad().is_finite() {
+            self.attitude = attitude;
+            self.angular_rate_rad_s = imu.angular_rate.map(|w| w.si());
+            self.imu.feed(now);
+        }
+    }
+
+    /// Whether every leg and the wheels have reported at least once.
+    pub fn drives_ever_reported(&self) -> bool {
+        self.legs.iter().all(Watchdog::ever_fed) && self.wheels.ever_fed()
+    }
+
+    /// Whether any leg or the wheels went silent.
+    pub fn drives_stale(&self, now: Tick) -> bool {
+        self.legs.iter().any(|w| w.expired(now)) || self.wheels.expired(now)
+    }
+
+    /// Whether the IMU went silent.
+    pub fn imu_stale(&self, now: Tick) -> bool {
+        self.imu.expired(now)
+    }
+
+    /// Mean wheel joint rate, rad/s.
+    pub fn mean_wheel_rate_rad_s(&self) -> f32 {
+        let [left, right] = self.wheel_rate_rad_s;
+        0.5 * (left + right)
+    }
+
+    /// Half the wheel rate difference, left minus right, rad/s.
+    pub fn differential_wheel_rate_rad_s(&self) -> f32 {
+        let [left, right] = self.wheel_rate_rad_s;
+        0.5 * (left - right)
+    }
+}
+
+/// Position of `leg` in wire order.
+pub const fn leg_index(leg: Leg) -> usize {
+    match leg {
+        Leg::Fl => 0,
+        Leg::Fr => 1,
+        Leg::Bl => 2,
+        Leg::Br => 3,
+    }
+}
