@@ -325,7 +325,7 @@ impl Controller {
         let goals: [Result<LegJoints, _>; 4] = match (motion, self.state) {
             (LegMotion::Trot(direction), State::Legs(_)) => self.trot.targets(
                 direction,
-                depth_m,
+                config.posture.trot_depth_for(self.teleop.body_height_m),
                 self.teleop.speed_scale,
                 &config.geometry,
                 &config.limits,

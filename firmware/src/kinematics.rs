@@ -63,6 +63,11 @@ impl LegGeometry {
 /// workspace boundary (a fully stretched leg) lands a few ulp outside.
 const COS_TOLERANCE: f32 = 1e-5;
 
+/// How far past a joint limit a solution may land from rounding and still count as on it, rad.
+/// Near a straight knee `q2 = arccos(c)` amplifies the f32 rounding of `c` by `1 / sin q2`
+/// (2e-5 rad at q2 = 0.01 rad), so the tolerance is 2e-4 rad (0.01°).
+const LIMIT_TOLERANCE_RAD: f32 = 2e-4;
+
 /// Which of the two knee solutions to take.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum KneeBranch {
@@ -277,12 +282,23 @@ pub fn leg_ik(
         },
         branch,
     )?;
-    let joints = LegJoints {
+    let solved = LegJoints {
         hip_abduction_rad: abduction,
         hip_pitch_rad: wrap_pi(planar.q1_rad + FRAC_PI_2),
         knee_rad: planar.q2_rad,
         ankle_rad: planar.q3_rad,
     };
+    // A pose on a joint's limit solves to within rounding of it, on either side: snap those.
+    let mut snapped = solved.to_array();
+    for (angle, joint) in snapped.iter_mut().zip(Joint::ALL) {
+        let range = limits.range(joint);
+        if *angle >= range.min_rad - LIMIT_TOLERANCE_RAD
+            && *angle <= range.max_rad + LIMIT_TOLERANCE_RAD
+        {
+            *angle = clamp(*angle, range.min_rad, range.max_rad);
+        }
+    }
+    let joints = LegJoints::from_array(snapped);
     match joints.first_violation(limits) {
         Some((joint, angle_rad)) => Err(IkError::JointLimit { joint, angle_rad }),
         None => Ok(joints),

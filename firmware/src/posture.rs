@@ -7,7 +7,8 @@
 //! nominal stance; here it becomes the depth of the feet below the hips. With the report's
 //! joint ranges the hips (±50°) only let the feet stand under the hips between 0.287 m and
 //! 0.38 m below them (a straight leg), so the offset is clamped into the band
-//! `[depth_min_m, depth_max_m]` where the stance and the whole trot cycle have IK solutions.
+//! `[depth_min_m, depth_max_m]` where the stance has IK solutions, and a trot further to
+//! `trot_depth_min_m` so that the swing arc stays in reach.
 //! [`Posture::body_height_range_m`] says what the legs can realise.
 //!
 //! # Foot pitch
@@ -15,7 +16,10 @@
 //! The leg has three sagittal joints for a 2-D foot position, so the foot pitch φ is a free
 //! choice. It is scheduled linearly in the foot position, fitted to the middle of the window
 //! of φ in which all joints stay in range over the gait's workspace:
-//! `φ = φ0 + dφ/dx · x + dφ/dd · (depth − d_ref)`.
+//! `φ = φ0 + dφ/dx · x + dφ/dd · (depth − d_ref)`. The fit (φ0 = −121°, 120°/m, 500°/m about
+//! 0.33 m) keeps every joint 0.5° inside its range for a stance 0.30…0.37 m deep and for the
+//! default trot (8 cm stride, 4 cm clearance) on a stance line 0.345…0.37 m deep; the test
+//! `every_gait_pose_solves_across_the_body_height_band_and_speed_scales` holds it to that.
 
 use crate::kinematics::{leg_ik, FootTarget, IkError, KneeBranch, LegGeometry, LegJoints};
 use crate::limits::JointLimits;
@@ -37,6 +41,9 @@ pub struct Posture {
     pub depth_min_m: f32,
     /// Deepest stance the legs realise, m.
     pub depth_max_m: f32,
+    /// Shallowest stance line of the trot, m: the swing arc rises above it and must stay in
+    /// reach.
+    pub trot_depth_min_m: f32,
     /// φ0 of the schedule, rad.
     pub pitch_base_rad: f32,
     /// dφ/dx, rad per m of forward foot position.
@@ -61,8 +68,9 @@ impl Posture {
         depth_nominal_m: 0.35,
         depth_min_m: 0.30,
         depth_max_m: 0.37,
-        pitch_base_rad: deg(-113.0),
-        pitch_per_x_rad_m: deg(162.0),
+        trot_depth_min_m: 0.345,
+        pitch_base_rad: deg(-121.0),
+        pitch_per_x_rad_m: deg(120.0),
         pitch_per_depth_rad_m: deg(500.0),
         pitch_reference_depth_m: 0.33,
         branch: KneeBranch::Down,
@@ -77,6 +85,13 @@ impl Posture {
         } else {
             self.depth_nominal_m
         }
+    }
+
+    /// Stance-line depth of the trot for a body-height offset: [`Posture::depth_for`], raised
+    /// to at least `trot_depth_min_m`.
+    pub fn trot_depth_for(&self, body_height_offset_m: f32) -> f32 {
+        self.depth_for(body_height_offset_m)
+            .max(self.trot_depth_min_m)
     }
 
     /// The body-height offsets the legs realise, `(lowest, highest)`, m.

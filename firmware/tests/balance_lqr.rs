@@ -68,14 +68,16 @@ fn lqr(a: &Matrix4<f64>, b: &Matrix4x1<f64>, q: &Matrix4<f64>, r: f64) -> [f64; 
     [k[0], k[1], k[2], k[3]]
 }
 
+/// Bryson's rule: each state and the input weighted by 1 / (its largest acceptable value)².
 fn bryson() -> (Matrix4<f64>, f64) {
+    let weight = |largest: f64| 1.0 / (largest * largest);
     let q = Matrix4::from_diagonal(&nalgebra::Vector4::new(
-        1.0 / (0.2 * 0.2),
-        1.0 / (0.1 * 0.1),
-        1.0 / (0.5 * 0.5),
-        1.0 / (1.0 * 1.0),
+        weight(0.2),
+        weight(0.1),
+        weight(0.5),
+        weight(1.0),
     ));
-    (q, 1.0 / (30.0 * 30.0))
+    (q, weight(30.0))
 }
 
 fn designed_gains() -> [f64; 4] {

@@ -1,0 +1,199 @@
+//! The trot: integer phase (ten hours = ten seconds), diagonal pairs in antiphase, backward as
+//! time reversal, the Cartesian foot path on the ground line, and IK solutions over the whole
+//! body-height band.
+
+use firmware::config::Config;
+use firmware::fsm::Direction;
+use firmware::gait::{Generator, Trot, TrotParams};
+use firmware::kinematics::{leg_fk, LegJoints};
+use firmware::phase::{Phase, PhaseStep};
+use firmware::sine_gait::SineGait;
+use firmware::time::TickRate;
+use protocol::Leg;
+
+const CONFIG: Config = Config::ROBOT;
+const TEN_SECONDS: u64 = 10 * 250;
+const TEN_HOURS: u64 = 10 * 3600 * 250;
+
+fn targets(trot: &Trot, direction: Direction, depth_m: f32) -> [LegJoints; 4] {
+    trot.targets(
+        direction,
+        depth_m,
+        1.0,
+        &CONFIG.geometry,
+        &CONFIG.limits,
+        &CONFIG.posture,
+    )
+    .map(|t| t.expect("IK solves every gait pose"))
+}
+
+fn one_cycle_after(ticks: u64, params: TrotParams) -> Vec<[LegJoints; 4]> {
+    let mut trot = Trot::new(params, TickRate::SIM_250_HZ).unwrap();
+    trot.set_phase(Phase::after(trot.step(), ticks));
+    (0..250)
+        .map(|_| {
+            let out = targets(&trot, Direction::Forward, CONFIG.posture.depth_nominal_m);
+            trot.advance();
+            out
+        })
+        .collect()
+}
+
+#[test]
+fn the_gait_after_ten_hours_is_the_gait_after_ten_seconds() {
+    for params in [TrotParams::DEFAULT, TrotParams::REPORT] {
+        assert_eq!(
+            one_cycle_after(TEN_SECONDS, params),
+            one_cycle_after(TEN_HOURS, params)
+        );
+    }
+}
+
+#[test]
+fn stepping_ten_hours_tick_by_tick_lands_exactly_on_the_ideal_phase() {
+    // 1 Hz and an awkward 1.3 Hz at 250 Hz: the Bresenham remainder keeps the phase exact.
+    for frequency_mhz in [1000, 1300] {
+        let step = PhaseStep::new(frequency_mhz, TickRate::SIM_250_HZ).unwrap();
+        let mut phase = Phase::default();
+        for _ in 0..TEN_HOURS {
+            phase.advance(step);
+        }
+        assert_eq!(phase, Phase::after(step, TEN_HOURS));
+        let ideal = (TEN_HOURS as u128 * frequency_mhz as u128 * (1u128 << 32) / (250 * 1000))
+            % (1u128 << 32);
+        assert_eq!(phase.count() as u128, ideal, "{frequency_mhz} mHz");
+    }
+    // What the integer phase avoids: the report's float time `t += dt` after ten hours.
+    let mut t = 0.0f32;
+    for _ in 0..TEN_HOURS {
+        t += 0.004;
+    }
+    assert!((t - 36_000.0).abs() > 1.0, "f32 time drifts to {t}");
+}
+
+#[test]
+fn diagonal_pairs_move_together_and_half_a_cycle_apart() {
+    for params in [TrotParams::DEFAULT, TrotParams::REPORT] {
+        let mut trot = Trot::new(params, TickRate::SIM_250_HZ).unwrap();
+        let mut history = Vec::new();
+        for _ in 0..250 {
+            history.push(targets(&trot, Direction::Forward, 0.35));
+            trot.advance();
+        }
+        for (tick, legs) in history.iter().enumerate() {
+            let [fl, fr, bl, br] = *legs;
+            assert_eq!(fl, br, "FL and BR pair at tick {tick}");
+            assert_eq!(fr, bl, "FR and BL pair at tick {tick}");
+            let half_later = history[(tick + 125) % 250][1];
+            for (a, b) in fl.to_array().iter().zip(half_later.to_array()) {
+                assert!(
+                    (a - b).abs() < 1e-3,
+                    "FR lags FL by half a cycle at tick {tick}"
+                );
+            }
+        }
+    }
+}
+
+fn foot_path(direction: Direction) -> Vec<(f32, f32)> {
+    let mut trot = Trot::new(TrotParams::DEFAULT, TickRate::SIM_250_HZ).unwrap();
+    (0..250)
+        .map(|_| {
+            let fl = targets(&trot, direction, 0.35)[0];
+            trot.advance();
+            let foot = leg_fk(&CONFIG.geometry, &fl);
+            (foot.x_m, foot.z_m)
+        })
+        .collect()
+}
+
+#[test]
+fn the_cartesian_foot_pushes_back_along_the_ground_and_swings_over_it() {
+    let path = foot_path(Direction::Forward);
+    let (stance, swing) = path.split_at(125);
+    for window in stance.windows(2) {
+        assert!(
+            (window[0].1 + 0.35).abs() < 1e-4,
+            "stance on the ground line"
+        );
+        assert!(window[1].0 < window[0].0, "stance pushes the foot backward");
+    }
+    let stride = stance[0].0 - stance[124].0;
+    assert!((stride - 0.08).abs() < 2e-3, "stride {stride} m");
+    let apex = swing.iter().map(|p| p.1).fold(f32::MIN, f32::max);
+    assert!((apex - (-0.35 + 0.04)).abs() < 1e-3, "swing apex {apex} m");
+}
+
+#[test]
+fn walking_backward_runs_the_foot_path_backward() {
+    let forward = foot_path(Direction::Forward);
+    let backward = foot_path(Direction::Backward);
+    // Backward at tick k is forward at tick −k (mod one cycle).
+    for (k, point) in backward.iter().enumerate() {
+        let mirror = forward[(250 - k) % 250];
+        assert!((point.0 - mirror.0).abs() < 1e-3 && (point.1 - mirror.1).abs() < 1e-3);
+    }
+    // And the stance (foot on the ground) now moves the foot forward: the body goes back.
+    let on_ground: Vec<_> = backward
+        .iter()
+        .filter(|p| (p.1 + 0.35).abs() < 1e-4)
+        .collect();
+    assert!(on_ground.len() > 100);
+    assert!(on_ground.windows(2).filter(|w| w[1].0 > w[0].0).count() > 100);
+}
+
+#[test]
+fn the_reports_sinusoids_are_reproduced() {
+    let mut trot = Trot::new(TrotParams::REPORT, TickRate::SIM_250_HZ).unwrap();
+    // A quarter cycle in: sin = 1 for the leading pair.
+    for _ in 0..(250 / 4) {
+        trot.advance();
+    }
+    let [fl, fr, ..] = targets(&trot, Direction::Forward, 0.35);
+    let expect = |joints: LegJoints, s: f32| {
+        let report = SineGait::REPORT;
+        assert!((joints.hip_pitch_rad - report.hip_amplitude_rad * s).abs() < 1e-4);
+        assert!(
+            (joints.knee_rad - (report.knee_base_rad + report.knee_amplitude_rad * s)).abs() < 1e-4
+        );
+        assert!((joints.ankle_rad - report.ankle_amplitude_rad * s).abs() < 1e-4);
+        assert_eq!(joints.hip_abduction_rad, 0.0);
+    };
+    expect(fl, 1.0);
+    expect(fr, -1.0);
+}
+
+#[test]
+fn every_gait_pose_solves_across_the_body_height_band_and_speed_scales() {
+    let posture = CONFIG.posture;
+    let Generator::Cartesian(_) = TrotParams::DEFAULT.generator else {
+        panic!("the default gait is the Cartesian one");
+    };
+    for height_step in 0..=20 {
+        let offset = -0.10 + 0.22 * height_step as f32 / 20.0; // the whole wire range
+        let depth = posture.depth_for(offset);
+        assert!(depth >= posture.depth_min_m && depth <= posture.depth_max_m);
+        posture
+            .stance(&CONFIG.geometry, &CONFIG.limits, depth)
+            .unwrap_or_else(|e| panic!("stance at {depth} m: {e:?}"));
+        let depth = posture.trot_depth_for(offset);
+        for scale in [0.0, 0.5, 1.0] {
+            let mut trot = Trot::new(TrotParams::DEFAULT, TickRate::SIM_250_HZ).unwrap();
+            for tick in 0..250 {
+                for (leg, result) in Leg::ALL.iter().zip(trot.targets(
+                    Direction::Forward,
+                    depth,
+                    scale,
+                    &CONFIG.geometry,
+                    &CONFIG.limits,
+                    &posture,
+                )) {
+                    if let Err(e) = result {
+                        panic!("{leg:?} at depth {depth} m, scale {scale}, tick {tick}: {e:?}");
+                    }
+                }
+                trot.advance();
+            }
+        }
+    }
+}
