@@ -1,0 +1,402 @@
+//! The control step against an ideal plant (every drive reaches its target, the torso stays
+//! level): transitions, watchdogs, the E-stop latch, and the safety clamp under arbitrary input.
+
+use firmware::controller::Output;
+use firmware::fsm::{LegMotion, State, WheelMotion};
+use firmware::{Config, Controller, Tick};
+use proptest::prelude::*;
+use protocol::{
+    Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, EStop, EStopAction, FaultFlags, Imu,
+    JointVelocity, Leg, LegFeedback, NodeId, QuatComponent, SpeedScale, TeleopCommand,
+    TeleopHeartbeat, TeleopMode, Torque, WheelAngle, WheelFeedback, WheelVelocity,
+};
+
+const CONFIG: Config = Config::ROBOT;
+
+/// A plant whose drives reach their targets at once and whose torso stays level.
+struct Bench {
+    controller: Controller,
+    now: u32,
+    joints_rad: [f32; 16],
+    drives_alive: bool,
+    imu_alive: bool,
+    teleop_alive: bool,
+    pitch_rad: f32,
+}
+
+fn leg_feedback(positions: &[f32]) -> LegFeedback {
+    let mut position = [Angle::saturating_from_si(0.0); 4];
+    for (slot, value) in position.iter_mut().zip(positions) {
+        *slot = Angle::saturating_from_si(*value);
+    }
+    LegFeedback {
+        position,
+        velocity: [JointVelocity::saturating_from_si(0.0); 4],
+        effort: [Torque::saturating_from_si(0.0); 4],
+    }
+}
+
+fn imu(pitch_rad: f32) -> Imu {
+    let half = 0.5 * pitch_rad;
+    Imu {
+        orientation: [half.cos(), 0.0, half.sin(), 0.0].map(QuatComponent::saturating_from_si),
+        angular_rate: [AngularRate::saturating_from_si(0.0); 3],
+        acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
+    }
+}
+
+fn command(mode: TeleopMode) -> AnyMessage {
+    AnyMessage::TeleopCommand(TeleopCommand {
+        mode,
+        body_height: BodyHeight::saturating_from_si(0.0),
+        speed_scale: SpeedScale::from_raw(100).unwrap(),
+    })
+}
+
+fn estop(action: EStopAction) -> AnyMessage {
+    AnyMessage::EStop(EStop {
+        action,
+        source: NodeId::Tool,
+    })
+}
+
+impl Bench {
+    fn new() -> Self {
+        // Start on the legs, roughly standing.
+        let stance = CONFIG
+            .posture
+            .stance(
+                &CONFIG.geometry,
+                &CONFIG.limits,
+                CONFIG.posture.depth_nominal_m,
+            )
+            .unwrap()
+            .to_array();
+        let mut joints = [0.0; 16];
+        for chunk in joints.chunks_exact_mut(4) {
+            chunk.copy_from_slice(&stance);
+        }
+        Self {
+            controller: Controller::new(CONFIG).unwrap(),
+            now: 0,
+            joints_rad: joints,
+            drives_alive: true,
+            imu_alive: true,
+            teleop_alive: true,
+            pitch_rad: 0.0,
+        }
+    }
+
+    fn send(&mut self, message: AnyMessage) {
+        self.controller.on_message(Tick(self.now), &message);
+    }
+
+    fn tick(&mut self) -> Output {
+        let now = Tick(self.now);
+        if self.drives_alive {
+            for (leg, chunk) in Leg::ALL.iter().zip(self.joints_rad.chunks_exact(4)) {
+                self.controller
+                    .on_message(now, &AnyMessage::LegFeedback(*leg, leg_feedback(chunk)));
+            }
+            self.controller.on_message(
+                now,
+                &AnyMessage::WheelFeedback(WheelFeedback {
+                    position: [WheelAngle::saturating_from_si(0.0); 2],
+                    velocity: [WheelVelocity::saturating_from_si(0.0); 2],
+                    effort: [Torque::saturating_from_si(0.0); 2],
+                }),
+            );
+        }
+        if self.imu_alive {
+            self.controller
+                .on_message(now, &AnyMessage::Imu(imu(self.pitch_rad)));
+        }
+        if self.teleop_alive && self.now % 5 == 0 {
+            self.controller.on_message(
+                now,
+                &AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
+                    uptime: protocol::Millis::from_raw(self.now * 4).unwrap(),
+                }),
+            );
+        }
+        let output = self.controller.step(now);
+        if output.legs_enabled {
+            self.joints_rad = output.leg_targets_rad;
+        }
+        self.now += 1;
+        output
+    }
+
+    fn run(&mut self, ticks: u32) -> Output {
+        let mut last = self.tick();
+        for _ in 1..ticks {
+            last = self.tick();
+        }
+        last
+    }
+
+    fn state(&self) -> State {
+        self.controller.state()
+    }
+}
+
+fn ms(ms: u32) -> u32 {
+    CONFIG.rate.ticks_from_ms(ms)
+}
+
+#[test]
+fn drives_stay_torque_free_until_every_drive_has_reported() {
+    let mut bench = Bench::new();
+    bench.drives_alive = false;
+    let output = bench.run(10);
+    assert!(!output.legs_enabled);
+    assert!(output.status.faults.contains(FaultFlags::FEEDBACK_TIMEOUT));
+    assert_eq!(bench.state(), State::Hold);
+    bench.drives_alive = true;
+    let output = bench.run(2);
+    assert!(output.legs_enabled);
+    // Holding exactly where the legs are: no jump on power-up.
+    assert_eq!(output.leg_targets_rad, bench.joints_rad);
+}
+
+#[test]
+fn w_folds_the_legs_at_the_fold_rate_then_drives_on_the_wheels() {
+    let mut bench = Bench::new();
+    bench.run(5);
+    bench.send(command(TeleopMode::WheelForward));
+    let output = bench.tick();
+    assert_eq!(
+        bench.state(),
+        State::Folding(WheelMotion::Drive(firmware::fsm::Direction::Forward))
+    );
+    assert_eq!(output.status.mode, protocol::ControllerMode::Folding);
+    // The report's smoothing at rate 6 /s: the first step covers 6 · 0.004 = 2.4 % of the way.
+    let mut ticks = 1;
+    while matches!(bench.state(), State::Folding(_)) {
+        bench.tick();
+        ticks += 1;
+        assert!(ticks < 500, "folding never finished");
+    }
+    // e^(−6 t) from up to ~1.6 rad to 0.01 rad: ≈ 0.85 s.
+    let seconds = ticks as f32 / 250.0;
+    assert!((0.5..1.2).contains(&seconds), "folded in {seconds} s");
+    assert_eq!(
+        bench.state(),
+        State::Wheels(WheelMotion::Drive(firmware::fsm::Direction::Forward))
+    );
+    // Hip pitch of the fold pose (−1.0 rad) is clamped to the report's −50° limit.
+    let hip = bench.joints_rad[1];
+    assert!((hip - (-50f32).to_radians()).abs() < 0.011, "hip {hip}");
+}
+
+#[test]
+fn trot_from_the_wheels_stands_up_first() {
+    let mut bench = Bench::new();
+    bench.run(5);
+    bench.send(command(TeleopMode::Fold));
+    bench.run(400);
+    assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+    bench.send(command(TeleopMode::TrotForward));
+    bench.tick();
+    assert_eq!(
+        bench.state(),
+        State::Standing(LegMotion::Trot(firmware::fsm::Direction::Forward))
+    );
+    bench.run(400);
+    assert_eq!(
+        bench.state(),
+        State::Legs(LegMotion::Trot(firmware::fsm::Direction::Forward))
+    );
+    // And the legs now move: the gait, not a frozen pose.
+    let a = bench.tick().leg_targets_rad;
+    let b = bench.run(60).leg_targets_rad;
+    assert!(a.iter().zip(b).any(|(x, y)| (x - y).abs() > 0.02));
+}
+
+#[test]
+fn silent_feedback_safe_stops_within_fifty_milliseconds() {
+    let mut bench = Bench::new();
+    bench.run(5);
+    bench.send(command(TeleopMode::TrotForward));
+    bench.run(300);
+    assert!(matches!(bench.state(), State::Legs(LegMotion::Trot(_))));
+    bench.drives_alive = false;
+    let mut ticks = 0;
+    while bench.state() != State::Fault {
+        bench.tick();
+        ticks += 1;
+        assert!(ticks <= ms(50) + 1, "no fault after {ticks} ticks");
+    }
+    assert!(ticks * 4 <= 56, "fault after {} ms", ticks * 4);
+    let output = bench.tick();
+    assert!(output.status.faults.contains(FaultFlags::FEEDBACK_TIMEOUT));
+    assert_eq!(output.wheel_torque_nm, [0.0, 0.0]);
+    // Holds its legs where they were, and stays faulted while feedback is missing.
+    let held = output.leg_targets_rad;
+    assert_eq!(bench.run(50).leg_targets_rad, held);
+    bench.send(command(TeleopMode::Stop));
+    assert_eq!(bench.state(), State::Fault);
+    // Feedback back and the operator asks to stop: reset to Hold.
+    bench.drives_alive = true;
+    bench.tick();
+    bench.send(command(TeleopMode::Stand));
+    bench.send(command(TeleopMode::Stop));
+    assert_eq!(bench.state(), State::Hold);
+}
+
+#[test]
+fn a_silent_operator_stops_the_robot_after_half_a_second() {
+    let mut bench = Bench::new();
+    bench.run(5);
+    bench.send(command(TeleopMode::TrotForward));
+    bench.run(300);
+    while bench.now % 5 != 1 {
+        bench.tick();
+    }
+    // The last heartbeat went out on the previous tick.
+    bench.teleop_alive = false;
+    let mut ticks = 1;
+    while matches!(bench.state(), State::Legs(LegMotion::Trot(_))) {
+        bench.tick();
+        ticks += 1;
+        assert!(ticks < 200, "still trotting");
+    }
+    let silent_ms = ticks * 4;
+    assert!(
+        (500..=508).contains(&silent_ms),
+        "stopped {silent_ms} ms after the last heartbeat"
+    );
+    assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
+    assert!(bench
+        .tick()
+        .status
+        .faults
+        .contains(FaultFlags::TELEOP_TIMEOUT));
+    // The operator comes back still holding L: no restart without a new key.
+    bench.teleop_alive = true;
+    bench.send(command(TeleopMode::TrotForward));
+    bench.run(20);
+    assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
+}
+
+#[test]
+fn an_estop_latches_until_an_explicit_clear() {
+    let mut bench = Bench::new();
+    bench.run(5);
+    bench.send(command(TeleopMode::WheelForward));
+    bench.run(300);
+    bench.send(estop(EStopAction::Latch));
+    let output = bench.tick();
+    assert!(!output.legs_enabled);
+    assert_eq!(output.wheel_torque_nm, [0.0, 0.0]);
+    assert!(output.status.faults.contains(FaultFlags::ESTOP_LATCHED));
+    for mode in [
+        TeleopMode::Stop,
+        TeleopMode::TrotForward,
+        TeleopMode::WheelRotate,
+    ] {
+        bench.send(command(mode));
+        let output = bench.run(25);
+        assert!(!output.legs_enabled && output.wheel_torque_nm == [0.0, 0.0]);
+        assert_eq!(bench.state(), State::EStop);
+    }
+    bench.send(estop(EStopAction::Clear));
+    let output = bench.tick();
+    assert_eq!(bench.state(), State::Hold);
+    // Hold where the legs lie now: no jump back to the pre-stop targets.
+    assert!(output.legs_enabled);
+    assert_eq!(output.leg_targets_rad, bench.joints_rad);
+}
+
+#[test]
+fn a_fall_is_a_fault() {
+    let mut bench = Bench::new();
+    bench.run(5);
+    bench.send(command(TeleopMode::WheelForward));
+    bench.run(100);
+    bench.pitch_rad = 1.0;
+    bench.run(2);
+    assert_eq!(bench.state(), State::Fault);
+    assert!(bench.tick().status.faults.contains(FaultFlags::TILT_LIMIT));
+}
+
+fn any_message() -> impl Strategy<Value = AnyMessage> {
+    let angle = (-3.3f32..3.3).prop_map(Angle::saturating_from_si);
+    let leg = prop::sample::select(Leg::ALL.to_vec());
+    let mode = (0u8..8).prop_map(|raw| TeleopMode::from_raw(raw).unwrap());
+    prop_oneof![
+        (leg, prop::array::uniform4(angle.clone())).prop_map(|(leg, position)| {
+            AnyMessage::LegFeedback(
+                leg,
+                LegFeedback {
+                    position,
+                    velocity: [JointVelocity::saturating_from_si(1.0); 4],
+                    effort: [Torque::saturating_from_si(0.0); 4],
+                },
+            )
+        }),
+        (
+            prop::array::uniform4(-1.0f32..1.0),
+            prop::array::uniform3(-30.0f32..30.0)
+        )
+            .prop_map(|(q, w)| AnyMessage::Imu(Imu {
+                orientation: q.map(QuatComponent::saturating_from_si),
+                angular_rate: w.map(AngularRate::saturating_from_si),
+                acceleration: [Acceleration::saturating_from_si(0.0); 3],
+            })),
+        prop::array::uniform2(-300.0f32..300.0).prop_map(|v| AnyMessage::WheelFeedback(
+            WheelFeedback {
+                position: [WheelAngle::saturating_from_si(0.0); 2],
+                velocity: v.map(WheelVelocity::saturating_from_si),
+                effort: [Torque::saturating_from_si(0.0); 2],
+            }
+        )),
+        (mode, -0.2f32..0.2, 0u8..=100).prop_map(|(mode, h, s)| AnyMessage::TeleopCommand(
+            TeleopCommand {
+                mode,
+                body_height: BodyHeight::saturating_from_si(h),
+                speed_scale: SpeedScale::from_raw(s).unwrap(),
+            }
+        )),
+        Just(AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
+            uptime: protocol::Millis::from_raw(0).unwrap()
+        })),
+        prop::bool::ANY.prop_map(|latch| estop(if latch {
+            EStopAction::Latch
+        } else {
+            EStopAction::Clear
+        })),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(300))]
+
+    /// Whatever arrives, in whatever order, with whatever gaps between ticks: every output is
+    /// finite and inside the joint and torque limits.
+    #[test]
+    fn no_input_sequence_produces_an_out_of_limit_or_non_finite_command(
+        script in prop::collection::vec((prop::collection::vec(any_message(), 0..6), 1u32..40), 1..120)
+    ) {
+        let mut controller = Controller::new(CONFIG).unwrap();
+        let mut now = 0u32;
+        for (messages, gap) in script {
+            for message in &messages {
+                controller.on_message(Tick(now), message);
+            }
+            now = now.wrapping_add(gap);
+            let output = controller.step(Tick(now));
+            for (chunk_index, chunk) in output.leg_targets_rad.chunks_exact(4).enumerate() {
+                for (joint, angle) in firmware::limits::Joint::ALL.into_iter().zip(chunk) {
+                    prop_assert!(
+                        angle.is_finite() && CONFIG.limits.range(joint).contains(*angle),
+                        "leg {chunk_index} {joint:?} = {angle}"
+                    );
+                }
+            }
+            for torque in output.wheel_torque_nm {
+                prop_assert!(torque.is_finite() && torque.abs() <= CONFIG.wheel_torque_limit_nm);
+            }
+        }
+    }
+}
