@@ -3,8 +3,8 @@
 //! Sans-IO: the core takes decoded CAN messages and the tick, and returns actuator commands and
 //! telemetry. It never touches a socket, a clock or a file, so the same code runs in host tests,
 //! in the host firmware process next to the simulator, and on the Cortex-M4F. No heap, no
-//! `f64`, integer time, bounded loops; clippy denies `unwrap`, `expect`, `panic` and unchecked
-//! indexing.
+//! double-precision floats, integer time, bounded loops; clippy denies `unwrap`, `expect`,
+//! `panic` and unchecked indexing.
 //!
 //! | layer | module | what it does |
 //! |---|---|---|

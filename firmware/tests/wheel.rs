@@ -19,9 +19,7 @@ fn a_long_saturation_does_not_wind_up_the_integral() {
         ticks += 1;
         assert!(ticks < 250, "still pushing after {ticks} ticks");
     }
-    assert!(ticks < 250);
-    // A naive integrator would hold 10 s × 4 rad/s × ki = 240 N·m of integral.
-    assert!(10.0 * 4.0 * GAINS.ki_nm_per_rad > 10.0 * GAINS.limit_nm);
+    // (A naive integrator would hold 10 s × 4 rad/s × ki = 240 N·m and push for seconds.)
 }
 
 #[test]

@@ -1,5 +1,6 @@
 //! `cargo xtask <task>`: every project task. This file only dispatches; each task is a module.
 
+mod bench;
 mod busload;
 mod dbc;
 mod demo;
@@ -19,6 +20,8 @@ Tasks:
                      no_std crates, all tests, and a thumbv7em-none-eabihf build of the no_std crates
   dbc [--check]      regenerate protocol/hybrid_robot.dbc (--check: fail if the committed file is stale)
   busload            print the per-cycle frame schedule and the bus load at 250 Hz and 1 kHz
+  bench [args]       criterion benchmarks of the control step, then a table of medians
+                     (args go to criterion, e.g. `--measurement-time 3`)
   demo               run the report's demonstration (not yet: arrives with the closed-loop issue)
 ";
 
@@ -36,6 +39,7 @@ fn main() -> ExitCode {
         "test" => test::run(),
         "dbc" => dbc::run(rest),
         "busload" => busload::run(),
+        "bench" => bench::run_task(rest),
         "demo" => demo::run(),
         "help" | "-h" | "--help" => {
             print!("{HELP}");

@@ -1,0 +1,177 @@
+//! One full control step of the core, measured on the host (`cargo xtask bench`):
+//!
+//! - `step/trot` and `step/wheels`: the typed core — six feedback messages in, then the step
+//!   (supervisor, FSM, 4-leg IK + gait or fold, balance + turn loop, smoothing, clamps);
+//! - `node/trot`: the same through the CAN node — six feedback frames decoded and E2E-checked,
+//!   the step, and the tick's frames encoded with CRC.
+
+use std::hint::black_box;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use firmware::{Config, Controller, Node, Tick};
+use protocol::{
+    Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, Frame, Imu, JointVelocity, Leg,
+    LegFeedback, QuatComponent, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, Torque,
+    WheelAngle, WheelFeedback, WheelVelocity,
+};
+
+fn feedback(joints_rad: &[f32; 16]) -> Vec<AnyMessage> {
+    let mut messages: Vec<AnyMessage> = Leg::ALL
+        .iter()
+        .zip(joints_rad.chunks_exact(4))
+        .map(|(leg, chunk)| {
+            let mut position = [Angle::saturating_from_si(0.0); 4];
+            for (slot, value) in position.iter_mut().zip(chunk) {
+                *slot = Angle::saturating_from_si(*value);
+            }
+            AnyMessage::LegFeedback(
+                *leg,
+                LegFeedback {
+                    position,
+                    velocity: [JointVelocity::saturating_from_si(0.1); 4],
+                    effort: [Torque::saturating_from_si(1.0); 4],
+                },
+            )
+        })
+        .collect();
+    messages.push(AnyMessage::WheelFeedback(WheelFeedback {
+        position: [WheelAngle::saturating_from_si(0.5); 2],
+        velocity: [WheelVelocity::saturating_from_si(2.0); 2],
+        effort: [Torque::saturating_from_si(1.0); 2],
+    }));
+    messages.push(AnyMessage::Imu(Imu {
+        orientation: [0.9999, 0.0, 0.0123, 0.0].map(QuatComponent::saturating_from_si),
+        angular_rate: [0.0, 0.05, 0.0].map(AngularRate::saturating_from_si),
+        acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
+    }));
+    messages
+}
+
+fn operator(mode: TeleopMode) -> [AnyMessage; 2] {
+    [
+        AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
+            uptime: protocol::Millis::from_raw(0).unwrap(),
+        }),
+        AnyMessage::TeleopCommand(TeleopCommand {
+            mode,
+            body_height: BodyHeight::saturating_from_si(0.0),
+            speed_scale: SpeedScale::from_raw(100).unwrap(),
+        }),
+    ]
+}
+
+/// A controller brought into `mode` by an ideal plant, and the tick it reached.
+fn controller_in(mode: TeleopMode) -> (Controller, u32) {
+    let target = match mode {
+        TeleopMode::TrotForward => firmware::fsm::State::Legs(firmware::fsm::LegMotion::Trot(
+            firmware::fsm::Direction::Forward,
+        )),
+        _ => firmware::fsm::State::Wheels(firmware::fsm::WheelMotion::Drive(
+            firmware::fsm::Direction::Forward,
+        )),
+    };
+    let mut controller = Controller::new(Config::ROBOT).unwrap();
+    let mut joints = [0.0f32; 16];
+    for tick in 0..600 {
+        for message in feedback(&joints) {
+            controller.on_message(Tick(tick), &message);
+        }
+        if tick % 5 == 0 {
+            let [heartbeat, command] = operator(mode);
+            controller.on_message(Tick(tick), &heartbeat);
+            if tick == 10 {
+                controller.on_message(Tick(tick), &command);
+            }
+        }
+        joints = controller.step(Tick(tick)).leg_targets_rad;
+    }
+    assert_eq!(
+        controller.state(),
+        target,
+        "the plant did not bring the controller to {mode:?}"
+    );
+    (controller, 600)
+}
+
+fn bench_step(c: &mut Criterion) {
+    for (name, mode) in [
+        ("step/trot", TeleopMode::TrotForward),
+        ("step/wheels", TeleopMode::WheelForward),
+    ] {
+        let (mut controller, start) = controller_in(mode);
+        let mut messages = feedback(&[0.1; 16]);
+        messages.push(operator(mode)[0]);
+        let expected = controller.state();
+        let mut tick = start;
+        c.bench_function(name, |b| {
+            b.iter(|| {
+                for message in &messages {
+                    controller.on_message(Tick(tick), black_box(message));
+                }
+                let output = controller.step(Tick(tick));
+                tick = tick.wrapping_add(1);
+                black_box(output)
+            })
+        });
+        assert_eq!(
+            controller.state(),
+            expected,
+            "{name} left its mode while measured"
+        );
+    }
+}
+
+fn bench_node(c: &mut Criterion) {
+    let mut node = Node::new(Config::ROBOT).unwrap();
+    // Every counter value once, so the ring of frames wraps exactly as the counters do.
+    let messages = feedback(&[0.1; 16]);
+    let ring: Vec<Vec<Frame>> = (0..=u16::MAX)
+        .map(|counter| {
+            messages
+                .iter()
+                .map(|m| m.encode(counter).unwrap())
+                .collect()
+        })
+        .collect();
+    let teleop: Vec<Frame> = (0..=u16::MAX)
+        .map(|counter| {
+            let [heartbeat, _] = operator(TeleopMode::TrotForward);
+            heartbeat.encode(counter).unwrap()
+        })
+        .collect();
+    let command = operator(TeleopMode::TrotForward)[1].encode(0).unwrap();
+    let mut tick: u32 = 0;
+    let feed = |node: &mut Node, tick: u32| {
+        let index = (tick as usize) % ring.len();
+        for frame in &ring[index] {
+            let _ = node.on_frame(Tick(tick), frame.id(), frame.data());
+        }
+        let beat = &teleop[index];
+        let _ = node.on_frame(Tick(tick), beat.id(), beat.data());
+    };
+    for _ in 0..600 {
+        feed(&mut node, tick);
+        if tick == 10 {
+            let _ = node.on_frame(Tick(tick), command.id(), command.data());
+        }
+        black_box(node.poll(Tick(tick)));
+        tick += 1;
+    }
+    let trotting = firmware::fsm::State::Legs(firmware::fsm::LegMotion::Trot(
+        firmware::fsm::Direction::Forward,
+    ));
+    assert_eq!(node.controller().state(), trotting);
+    c.bench_function("node/trot", |b| {
+        b.iter(|| {
+            feed(&mut node, tick);
+            let out = node.poll(Tick(tick));
+            tick = tick.wrapping_add(1);
+            black_box(out)
+        })
+    });
+    assert_eq!(node.controller().state(), trotting);
+    assert_eq!(node.reject_counters().total(), 0);
+}
+
+criterion_group!(benches, bench_step, bench_node);
+criterion_main!(benches);
