@@ -9,7 +9,7 @@
 //! 4. the legs' targets move toward the goal with the report's smoothing;
 //! 5. every output is clamped to the joint and torque limits and made finite.
 
-use protocol::{AnyMessage, ControllerMode, DriveFlags, EStopAction, FaultFlags};
+use protocol::{AnyMessage, ControllerMode, Drive, DriveFlags, EStopAction, FaultFlags};
 
 use crate::balance::{Balance, BalanceInput};
 use crate::config::Config;
@@ -79,7 +79,8 @@ pub struct Controller {
     goal_rad: [f32; 16],
     /// Whether the drives have reported positions so the targets start from them.
     armed: bool,
-    drive_fault: bool,
+    /// Latest fault report of each drive, in [`Drive::ALL`] order.
+    drive_faults: [bool; 5],
     tilted: bool,
     non_finite: bool,
     ik_failures: u32,
@@ -104,7 +105,7 @@ impl Controller {
             legs_rad: [0.0; 16],
             goal_rad: [0.0; 16],
             armed: false,
-            drive_fault: false,
+            drive_faults: [false; 5],
             tilted: false,
             non_finite: false,
             ik_failures: 0,
@@ -154,9 +155,14 @@ impl Controller {
                     }
                 }
             }
-            AnyMessage::DriveStatus(_, status) => {
-                if status.flags.contains(DriveFlags::FAULT) {
-                    self.drive_fault = true;
+            AnyMessage::DriveStatus(drive, status) => {
+                let faulted = status.flags.contains(DriveFlags::FAULT);
+                if let Some(index) = Drive::ALL.iter().position(|d| d == drive) {
+                    if let Some(slot) = self.drive_faults.get_mut(index) {
+                        *slot = faulted;
+                    }
+                }
+                if faulted {
                     self.apply(Event::Fault);
                 }
             }
@@ -257,7 +263,7 @@ impl Controller {
         if self.tilted {
             faults = faults.with(FaultFlags::TILT_LIMIT);
         }
-        if self.drive_fault {
+        if self.drive_faults.iter().any(|&faulted| faulted) {
             faults = faults.with(FaultFlags::DRIVE_FAULT);
         }
         faults
@@ -309,7 +315,6 @@ impl Controller {
             self.trot.restart();
         }
         if next == State::Hold {
-            self.drive_fault = false;
             self.legs_rad = if self.armed {
                 self.sensors.joint_position_rad
             } else {

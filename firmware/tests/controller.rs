@@ -320,6 +320,39 @@ fn a_fall_is_a_fault() {
     assert!(bench.tick().status.faults.contains(FaultFlags::TILT_LIMIT));
 }
 
+#[test]
+fn a_drive_fault_stops_the_robot_until_the_drive_recovers_and_the_operator_resets() {
+    use protocol::{Count, Drive, DriveFlags, DriveStatus};
+    let status = |flags: DriveFlags| {
+        AnyMessage::DriveStatus(
+            Drive::LegFl,
+            DriveStatus {
+                flags,
+                rejected: Count::ZERO,
+                commands: Count::ZERO,
+            },
+        )
+    };
+    let mut bench = Bench::new();
+    bench.run(5);
+    bench.send(command(TeleopMode::TrotForward));
+    bench.run(300);
+    bench.send(status(DriveFlags::ENABLED.with(DriveFlags::FAULT)));
+    assert_eq!(bench.state(), State::Fault);
+    assert!(bench.tick().status.faults.contains(FaultFlags::DRIVE_FAULT));
+    bench.send(command(TeleopMode::Stop));
+    assert_eq!(
+        bench.state(),
+        State::Fault,
+        "the drive still reports its fault"
+    );
+    bench.send(status(DriveFlags::ENABLED));
+    bench.send(command(TeleopMode::Stand));
+    bench.send(command(TeleopMode::Stop));
+    assert_eq!(bench.state(), State::Hold);
+    assert!(!bench.tick().status.faults.contains(FaultFlags::DRIVE_FAULT));
+}
+
 fn any_message() -> impl Strategy<Value = AnyMessage> {
     let angle = (-3.3f32..3.3).prop_map(Angle::saturating_from_si);
     let leg = prop::sample::select(Leg::ALL.to_vec());
