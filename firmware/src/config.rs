@@ -74,7 +74,7 @@ impl Config {
         feedback_timeout_ms: 50,
         imu_timeout_ms: 50,
         teleop_timeout_ms: 500,
-        tilt_limit_rad: 45.0 * (core::f32::consts::PI / 180.0),
+        tilt_limit_rad: crate::math::deg_to_rad(45.0),
     };
 
     /// This configuration at another control rate (gains are per second, so only the tick

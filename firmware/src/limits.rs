@@ -1,6 +1,8 @@
 //! Joint ranges of a leg, from the report's section 5.1 (hip1 ±35°, hip2 ±50°, knee −110…+15°,
 //! ankle ±40°), in the model's joint convention (see [`crate::kinematics`]).
 
+use crate::math::deg_to_rad;
+
 /// One joint's allowed range, `min_rad ≤ max_rad`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointRange {
@@ -11,6 +13,14 @@ pub struct JointRange {
 }
 
 impl JointRange {
+    /// The range `min_deg…max_deg`, given in degrees.
+    pub const fn from_degrees(min_deg: f32, max_deg: f32) -> Self {
+        Self {
+            min_rad: deg_to_rad(min_deg),
+            max_rad: deg_to_rad(max_deg),
+        }
+    }
+
     /// Whether `angle_rad` lies in the range (NaN does not).
     pub fn contains(self, angle_rad: f32) -> bool {
         angle_rad >= self.min_rad && angle_rad <= self.max_rad
@@ -50,10 +60,6 @@ impl Joint {
     ];
 }
 
-const fn deg(degrees: f32) -> f32 {
-    degrees * (core::f32::consts::PI / 180.0)
-}
-
 /// Ranges of the four joints of one leg (all four legs share them).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointLimits {
@@ -65,22 +71,10 @@ impl JointLimits {
     /// The report's ranges: hip1 ±35°, hip2 ±50°, knee −110…+15°, ankle ±40°.
     pub const REPORT: Self = Self {
         ranges: [
-            JointRange {
-                min_rad: deg(-35.0),
-                max_rad: deg(35.0),
-            },
-            JointRange {
-                min_rad: deg(-50.0),
-                max_rad: deg(50.0),
-            },
-            JointRange {
-                min_rad: deg(-110.0),
-                max_rad: deg(15.0),
-            },
-            JointRange {
-                min_rad: deg(-40.0),
-                max_rad: deg(40.0),
-            },
+            JointRange::from_degrees(-35.0, 35.0),
+            JointRange::from_degrees(-50.0, 50.0),
+            JointRange::from_degrees(-110.0, 15.0),
+            JointRange::from_degrees(-40.0, 40.0),
         ],
     };
 

@@ -15,6 +15,11 @@
 //! which this target would otherwise get; the trigonometric functions have no FPU instruction
 //! and come from `libm`.
 
+/// `degrees` in radians (for readable constants).
+pub const fn deg_to_rad(degrees: f32) -> f32 {
+    degrees * (core::f32::consts::PI / 180.0)
+}
+
 /// Square root. Negative or NaN input gives NaN (IEEE), so callers clamp first.
 #[inline]
 pub fn sqrt(x: f32) -> f32 {

@@ -23,10 +23,7 @@
 
 use crate::kinematics::{leg_ik, FootTarget, IkError, KneeBranch, LegGeometry, LegJoints};
 use crate::limits::JointLimits;
-
-const fn deg(degrees: f32) -> f32 {
-    degrees * (core::f32::consts::PI / 180.0)
-}
+use crate::math::deg_to_rad;
 
 /// Poses and the foot-pitch schedule.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -69,9 +66,9 @@ impl Posture {
         depth_min_m: 0.30,
         depth_max_m: 0.37,
         trot_depth_min_m: 0.345,
-        pitch_base_rad: deg(-121.0),
-        pitch_per_x_rad_m: deg(120.0),
-        pitch_per_depth_rad_m: deg(500.0),
+        pitch_base_rad: deg_to_rad(-121.0),
+        pitch_per_x_rad_m: deg_to_rad(120.0),
+        pitch_per_depth_rad_m: deg_to_rad(500.0),
         pitch_reference_depth_m: 0.33,
         branch: KneeBranch::Down,
     };
