@@ -1,7 +1,7 @@
 //! The controller as a CAN node: frames in, frames out, still sans-IO.
 //!
 //! [`Node::on_frame`] runs every received frame through the protocol's
-//! [`Receiver`](protocol::Receiver) — decode, CRC, rolling counter — so that nothing rejected
+//! [`Receiver`] — decode, CRC, rolling counter — so that nothing rejected
 //! reaches the controller, and every rejection is counted by cause. [`Node::poll`] runs one
 //! control tick and encodes the frames due in it, following the protocol's bus schedule
 //! ([`protocol::busload::SCHEDULE`]): wheel torques every tick, leg targets at up to 250 Hz,
