@@ -77,6 +77,8 @@ pub struct Controller {
     legs_rad: [f32; 16],
     /// Goal of the smoothing, wire order (kept so a failed IK holds the previous goal).
     goal_rad: [f32; 16],
+    /// The fold pose of all legs, clamped into the joint ranges once at construction.
+    fold_rad: [f32; 16],
     /// Whether the drives have reported positions so the targets start from them.
     armed: bool,
     /// Latest fault report of each drive, in [`Drive::ALL`] order.
@@ -104,6 +106,7 @@ impl Controller {
             turn: SpeedLoop::new(config.turn),
             legs_rad: [0.0; 16],
             goal_rad: [0.0; 16],
+            fold_rad: fold_goal(&config),
             armed: false,
             drive_faults: [false; 5],
             tilted: false,
@@ -178,8 +181,7 @@ impl Controller {
     pub fn step(&mut self, now: Tick) -> Output {
         self.supervise(now);
         if !self.armed {
-            self.legs_rad = self.sensors.joint_position_rad;
-            self.goal_rad = self.legs_rad;
+            self.follow_measured();
         }
         let dt_s = self.config.rate.period_s();
         let depth_m = self.config.posture.depth_for(self.teleop.body_height_m);
@@ -189,8 +191,7 @@ impl Controller {
         match self.state {
             State::EStop => {
                 legs_enabled = false;
-                self.legs_rad = self.sensors.joint_position_rad;
-                self.goal_rad = self.legs_rad;
+                self.follow_measured();
             }
             State::Hold | State::Fault => {}
             State::Legs(motion) | State::Standing(motion) => {
@@ -198,7 +199,7 @@ impl Controller {
                 self.smooth(self.config.leg_rate_per_s);
             }
             State::Folding(_) | State::Wheels(_) => {
-                self.goal_rad = fold_goal(&self.config);
+                self.goal_rad = self.fold_rad;
                 self.smooth(self.config.fold_rate_per_s);
             }
         }
@@ -272,8 +273,7 @@ impl Controller {
     fn supervise(&mut self, now: Tick) {
         if !self.armed && self.sensors.drives_ever_reported() && !self.sensors.drives_stale(now) {
             self.armed = true;
-            self.legs_rad = self.sensors.joint_position_rad;
-            self.goal_rad = self.legs_rad;
+            self.follow_measured();
         }
         let imu_stale = self.sensors.imu_stale(now);
         self.tilted = !imu_stale && self.sensors.attitude.tilt_rad() > self.config.tilt_limit_rad;
@@ -315,14 +315,17 @@ impl Controller {
             self.trot.restart();
         }
         if next == State::Hold {
-            self.legs_rad = if self.armed {
-                self.sensors.joint_position_rad
-            } else {
-                self.legs_rad
-            };
-            self.goal_rad = self.legs_rad;
+            // Unarmed, the targets already follow the measured positions every tick.
+            self.follow_measured();
         }
         self.state = next;
+    }
+
+    /// Targets and goal at the measured joint positions: nothing moves, and nothing jumps
+    /// when the drives are (re-)enabled.
+    fn follow_measured(&mut self) {
+        self.legs_rad = self.sensors.joint_position_rad;
+        self.goal_rad = self.legs_rad;
     }
 
     fn leg_goal(&mut self, motion: LegMotion, depth_m: f32) {
