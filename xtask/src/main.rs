@@ -4,6 +4,7 @@ mod bench;
 mod busload;
 mod dbc;
 mod demo;
+mod mujoco;
 mod setup;
 mod test;
 mod util;
@@ -14,7 +15,8 @@ const HELP: &str = "\
 cargo xtask <task> [options]
 
 Tasks:
-  setup              install what the project needs (rustup target, Python venv with cantools);
+  setup              install what the project needs (rustup target, Python venv with cantools,
+                     the MuJoCo library in .cache/mujoco);
                      idempotent, fast when already done
   test               everything CI checks: fmt, clippy -D warnings, DBC freshness, no f64 in the
                      no_std crates, all tests, and a thumbv7em-none-eabihf build of the no_std crates

@@ -2,7 +2,10 @@
 //!
 //! - the `thumbv7em-none-eabihf` rustup target (the MCU build);
 //! - a project-local Python venv (`.venv/`) with the pinned `cantools`, used by the tests that
-//!   read the bus with standard tools. Nothing is installed system-wide.
+//!   read the bus with standard tools, and pip's `download` for MuJoCo;
+//! - the MuJoCo library in `.cache/mujoco/` ([`crate::mujoco`]).
+//!
+//! Nothing is installed system-wide.
 
 use std::path::PathBuf;
 use std::process::Command;
@@ -20,6 +23,7 @@ pub fn venv_python() -> PathBuf {
 pub fn run() -> Result<(), String> {
     ensure_target()?;
     ensure_venv()?;
+    crate::mujoco::ensure()?;
     eprintln!("setup: done");
     Ok(())
 }

@@ -1,0 +1,79 @@
+//! One CAN bus abstraction for every node on the host: the simulator, the host firmware runner,
+//! teleop. Two implementations: [`crate::inproc_bus`] (deterministic, in one process) and
+//! [`crate::socketcan_bus`] (Linux SocketCAN: `vcan0`, `can0`).
+//!
+//! Semantics follow SocketCAN's defaults: a node receives every frame the *other* nodes send,
+//! in the order they were sent, and not its own.
+
+use std::time::Duration;
+
+use protocol::Frame;
+
+/// Why a bus operation failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum BusError {
+    /// The named CAN interface does not exist.
+    #[error(
+        "CAN interface `{ifname}` does not exist. For a virtual bus run:\n  \
+         sudo modprobe vcan && sudo ip link add {ifname} type vcan && sudo ip link set up {ifname}\n\
+         (or use `--bus inproc` for the in-process bus)"
+    )]
+    NoSuchInterface {
+        /// The interface asked for.
+        ifname: String,
+    },
+    /// The interface exists but is down.
+    #[error("CAN interface `{ifname}` is down: sudo ip link set up {ifname}")]
+    InterfaceDown {
+        /// The interface.
+        ifname: String,
+    },
+    /// The interface cannot carry CAN FD frames (MTU 72).
+    #[error(
+        "CAN interface `{ifname}` does not carry CAN FD frames: sudo ip link set {ifname} mtu 72"
+    )]
+    NotFd {
+        /// The interface.
+        ifname: String,
+    },
+    /// The kernel has no SocketCAN support at all.
+    #[error(
+        "this kernel has no SocketCAN support (opening `{ifname}`: {source}); load it with \
+         `sudo modprobe can can-raw vcan`, or use `--bus inproc`"
+    )]
+    NoCanSupport {
+        /// The interface.
+        ifname: String,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// Any other I/O error.
+    #[error("CAN interface `{ifname}`: {source}")]
+    Io {
+        /// The interface.
+        ifname: String,
+        /// The OS error.
+        source: std::io::Error,
+    },
+}
+
+/// A node's connection to a CAN bus.
+pub trait Bus {
+    /// Puts `frame` on the bus.
+    fn send(&mut self, frame: &Frame) -> Result<(), BusError>;
+
+    /// The next frame from another node, waiting at most `timeout` (zero: do not wait). `None`
+    /// when nothing arrived in time. Frames that are not CAN FD data frames with an 11-bit id
+    /// (error frames, remote frames, extended ids) are skipped and counted in
+    /// [`Bus::foreign_frames`].
+    fn recv(&mut self, timeout: Duration) -> Result<Option<Frame>, BusError>;
+
+    /// How many received frames this project's protocol cannot represent (see [`Bus::recv`]).
+    fn foreign_frames(&self) -> u64 {
+        0
+    }
+
+    /// A name for logs (`vcan0`, `inproc`).
+    fn name(&self) -> &str;
+}

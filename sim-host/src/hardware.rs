@@ -1,0 +1,128 @@
+//! All emulated nodes of the robot together — four leg drives, the wheel drive, the IMU — and
+//! the bus schedule they follow ([`protocol::busload::SCHEDULE`]): wheel feedback and IMU every
+//! cycle, leg feedback at 250 Hz, drive status at 10 Hz.
+//!
+//! The simulator also listens to the controller's status frames, as any bus observer can, to
+//! label its telemetry with the controller's mode.
+
+use protocol::busload::SCHEDULE;
+use protocol::{
+    decode_frame, AnyMessage, ControllerMode, Drive, EncodeError, Frame, Leg, MessageId,
+};
+
+use crate::imu::{ImuNode, ImuNoise};
+use crate::leg_drive::LegDrive;
+use crate::physics::Physics;
+use crate::wheel_drive::WheelDrive;
+
+/// The robot's CAN nodes.
+#[derive(Debug, Clone)]
+pub struct Hardware {
+    legs: [LegDrive; 4],
+    wheel: WheelDrive,
+    imu: ImuNode,
+    control_hz: u32,
+    controller_mode: Option<ControllerMode>,
+}
+
+impl Hardware {
+    /// The nodes, sending on the schedule of a controller running at `control_hz`.
+    pub fn new(control_hz: u32, imu_noise: ImuNoise) -> Self {
+        Self {
+            legs: Leg::ALL.map(LegDrive::new),
+            wheel: WheelDrive::default(),
+            imu: ImuNode::new(imu_noise),
+            control_hz,
+            controller_mode: None,
+        }
+    }
+
+    /// The leg drives, FL FR BL BR.
+    pub fn legs(&self) -> &[LegDrive; 4] {
+        &self.legs
+    }
+
+    /// The wheel drive.
+    pub fn wheel(&self) -> &WheelDrive {
+        &self.wheel
+    }
+
+    /// The controller's mode from its last status frame.
+    pub fn controller_mode(&self) -> Option<ControllerMode> {
+        self.controller_mode
+    }
+
+    /// Frames rejected by all drives together.
+    pub fn rejected(&self) -> u64 {
+        self.legs
+            .iter()
+            .map(|leg| u64::from(leg.core().rejected()))
+            .sum::<u64>()
+            + u64::from(self.wheel.core().rejected())
+    }
+
+    /// Hands a frame from the bus to every node (each filters and checks it itself).
+    pub fn on_frame(&mut self, now_us: u64, frame: &Frame) {
+        for leg in &mut self.legs {
+            leg.on_frame(now_us, frame);
+        }
+        self.wheel.on_frame(now_us, frame);
+        if frame.id() == MessageId::ControllerStatus.raw() {
+            if let Ok(decoded) = decode_frame(frame.id(), frame.data()) {
+                if let AnyMessage::ControllerStatus(status) = decoded.message {
+                    self.controller_mode = Some(status.mode);
+                }
+            }
+        }
+    }
+
+    /// Sets the simulation's actuators from the drives' state for the next step.
+    pub fn apply(&self, now_us: u64, physics: &mut Physics) {
+        for leg in &self.legs {
+            leg.apply(now_us, physics);
+        }
+        self.wheel.apply(now_us, physics);
+    }
+
+    /// The torques the wheel drive applies now, N·m.
+    pub fn wheel_torque_nm(&self, now_us: u64) -> [f64; 2] {
+        self.wheel.applied_torque_nm(now_us)
+    }
+
+    /// The frames the nodes send in control cycle `cycle`, in priority order.
+    pub fn frames_due(
+        &mut self,
+        now_us: u64,
+        cycle: u32,
+        physics: &Physics,
+    ) -> Result<Vec<Frame>, EncodeError> {
+        let mut frames = Vec::with_capacity(8);
+        for slot in SCHEDULE
+            .iter()
+            .filter(|s| s.sends_in(cycle, self.control_hz))
+        {
+            let (message, counter) = match slot.id {
+                MessageId::LegFeedback(leg) => {
+                    let drive = &mut self.legs[leg as usize];
+                    (drive.feedback(physics), drive.next_feedback_counter())
+                }
+                MessageId::WheelFeedback => (
+                    self.wheel.feedback(physics),
+                    self.wheel.next_feedback_counter(),
+                ),
+                MessageId::Imu => self.imu.sample(physics),
+                MessageId::DriveStatus(drive) => {
+                    let core = match drive {
+                        Drive::Wheel => self.wheel.core_mut(),
+                        leg => self.legs[leg as usize].core_mut(),
+                    };
+                    let (status, counter) = core.status(now_us);
+                    (AnyMessage::DriveStatus(drive, status), counter)
+                }
+                _ => continue,
+            };
+            frames.push(message.encode(counter)?);
+        }
+        Ok(frames)
+    }
+}

@@ -1,0 +1,32 @@
+//! The hybrid wheel–leg robot in MuJoCo, presented on a CAN bus as its real hardware would be:
+//! four leg drives, a wheel drive and an IMU, each a CAN node with the `protocol` crate's frames,
+//! E2E checks and a command timeout.
+//!
+//! - [`physics`]: the model and its state (ground truth);
+//! - [`bus`], [`inproc_bus`], [`socketcan_bus`]: one bus abstraction, two implementations;
+//! - [`leg_drive`], [`wheel_drive`], [`imu`], [`hardware`]: the emulated nodes;
+//! - [`lockstep`], [`realtime`]: the two clocks;
+//! - [`telemetry`], [`telemetry_csv`], [`candump`], [`plots`]: what a user looks at.
+
+pub mod bus;
+pub mod candump;
+pub mod drive_core;
+pub mod hardware;
+pub mod imu;
+pub mod inproc_bus;
+pub mod inproc_controller;
+pub mod leg_drive;
+pub mod lockstep;
+pub mod model;
+pub mod output_error;
+pub mod physics;
+pub mod socketcan_bus;
+pub mod telemetry;
+// pub mod plots;
+pub mod realtime;
+pub mod recorder;
+pub mod run_stats;
+pub mod scripted_teleop;
+pub mod simulator;
+pub mod telemetry_csv;
+pub mod wheel_drive;

@@ -1,0 +1,92 @@
+//! Lockstep: the simulator is the clock. Each cycle it sends SYNC and the nodes' feedback, waits
+//! for the controller's wheel command (the frame a controller sends every cycle, after its leg
+//! targets), then steps. Deterministic, and as fast as the two sides can go.
+//!
+//! A command that does not arrive within the reply timeout counts as a missed cycle; the drives
+//! then act on their previous commands (and time out after 100 ms, as real drives do).
+
+use std::time::{Duration, Instant};
+
+use protocol::{AnyMessage, E2eCounter, MessageId, Sync, Tick};
+
+use crate::bus::Bus;
+use crate::recorder::Recorder;
+use crate::run_stats::{RunError, RunStats};
+use crate::simulator::Simulator;
+
+/// Lockstep settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LockstepOptions {
+    /// Control cycles to run.
+    pub cycles: u64,
+    /// How long to wait for the controller's command each cycle.
+    pub reply_timeout: Duration,
+}
+
+/// Runs `options.cycles` cycles. `peers(cycle)` runs after the simulator has sent its frames
+/// and before it waits: nodes sharing this thread (the in-process controller, a scripted
+/// teleop) do their work there; over SocketCAN it is a no-op. `observe` sees the simulator after
+/// each cycle (progress, stop conditions); returning `false` ends the run early.
+pub fn run(
+    sim: &mut Simulator,
+    bus: &mut dyn Bus,
+    recorder: &mut Recorder,
+    options: LockstepOptions,
+    mut peers: impl FnMut(u32) -> Result<(), RunError>,
+    mut observe: impl FnMut(&Simulator) -> bool,
+) -> Result<RunStats, RunError> {
+    let started = Instant::now();
+    let mut stats = RunStats::default();
+    let mut sync_counter = E2eCounter::default();
+    for _ in 0..options.cycles {
+        let cycle = sim.cycle();
+        let time_s = sim.time_s();
+        let sync = AnyMessage::Sync(Sync {
+            tick: Tick::from_raw(cycle).unwrap_or(Tick::saturating_from_si(0.0)),
+        })
+        .encode(sync_counter.advance())?;
+        let mut outgoing = vec![sync];
+        outgoing.extend(sim.frames_due()?);
+        for frame in &outgoing {
+            bus.send(frame)?;
+            recorder.frame(time_s, frame)?;
+            stats.frames_sent += 1;
+        }
+        peers(cycle)?;
+        let deadline = Instant::now() + options.reply_timeout;
+        let mut commanded = false;
+        loop {
+            let wait = if commanded {
+                Duration::ZERO
+            } else {
+                deadline.saturating_duration_since(Instant::now())
+            };
+            match bus.recv(wait)? {
+                Some(frame) => {
+                    stats.frames_received += 1;
+                    recorder.frame(time_s, &frame)?;
+                    sim.receive(&frame);
+                    commanded |= frame.id() == MessageId::WheelCommand.raw();
+                }
+                None => break,
+            }
+        }
+        if !commanded {
+            stats.missed_cycles += 1;
+        }
+        sim.advance();
+        stats.cycles += 1;
+        if !sim.physics().is_finite() {
+            return Err(RunError::Diverged {
+                time_s: sim.time_s(),
+            });
+        }
+        recorder.row(sim.telemetry());
+        if !observe(sim) {
+            break;
+        }
+    }
+    stats.sim_s = sim.time_s();
+    stats.set_wall(started.elapsed());
+    Ok(stats)
+}

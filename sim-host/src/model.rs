@@ -1,0 +1,166 @@
+//! Loading the robot's MJCF and finding, by the report's names, every joint, actuator and sensor
+//! the emulated hardware uses. A model that lacks one is rejected with its name, before any step.
+
+use std::path::{Path, PathBuf};
+
+use mujoco_rs::prelude::MjModel;
+use mujoco_rs::wrappers::mj_model::MjtObjBase as MjtObj;
+use protocol::{JOINT_NAMES, WHEEL_NAMES};
+
+/// The robot on flat ground, shipped with the crate.
+pub const DEFAULT_MODEL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models/hybrid_robot.xml");
+/// The robot with a 6 cm step and a 10° ramp ahead of it.
+pub const OBSTACLES_MODEL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models/obstacles.xml");
+
+/// Why a model cannot be simulated.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ModelError {
+    /// MuJoCo rejected the file; its message names the element and line.
+    #[error("cannot load the model {path}: {message}")]
+    Load {
+        /// The file.
+        path: PathBuf,
+        /// MuJoCo's message.
+        message: String,
+    },
+    /// An object the emulated hardware needs is missing.
+    #[error(
+        "the model {path} has no {kind} named `{name}` (the simulator needs the report's names)"
+    )]
+    Missing {
+        /// The file.
+        path: PathBuf,
+        /// "joint", "actuator", "sensor", "body" or "site".
+        kind: &'static str,
+        /// The missing name.
+        name: String,
+    },
+    /// The model's timestep does not divide the control period.
+    #[error("the model {path} has timestep {timestep_s} s, which does not divide the control period {period_s} s")]
+    Timestep {
+        /// The file.
+        path: PathBuf,
+        /// Model timestep, s.
+        timestep_s: f64,
+        /// Control period, s.
+        period_s: f64,
+    },
+}
+
+/// Indices into MuJoCo's arrays for everything the hardware reads or drives.
+#[derive(Debug, Clone)]
+pub struct Layout {
+    /// `qpos` address of each leg joint, [`JOINT_NAMES`] order.
+    pub leg_qpos: [usize; 16],
+    /// `qvel` address of each leg joint.
+    pub leg_qvel: [usize; 16],
+    /// Actuator of each leg joint (`m_<joint>`).
+    pub leg_actuator: [usize; 16],
+    /// Actuator group of each leg (FL, FR, BL, BR), for going torque-free.
+    pub leg_group: [u32; 4],
+    /// `qpos` address of each wheel joint (left, right).
+    pub wheel_qpos: [usize; 2],
+    /// `qvel` address of each wheel joint.
+    pub wheel_qvel: [usize; 2],
+    /// Wheel actuators (`m_wheel_left`, `m_wheel_right`).
+    pub wheel_actuator: [usize; 2],
+    /// `sensordata` address of each leg actuator's force sensor.
+    pub leg_force_sensor: [usize; 16],
+    /// `sensordata` address of each wheel actuator's force sensor.
+    pub wheel_force_sensor: [usize; 2],
+    /// `sensordata` addresses of the IMU: quaternion (4), gyro (3), accelerometer (3).
+    pub imu_quat: usize,
+    /// Gyro.
+    pub imu_gyro: usize,
+    /// Accelerometer.
+    pub imu_accel: usize,
+    /// `sensordata` address of each foot's touch sensor (FL, FR, BL, BR).
+    pub foot_touch: [usize; 4],
+    /// The torso body.
+    pub torso_body: usize,
+    /// The two wheel geoms (left, right).
+    pub wheel_geoms: [usize; 2],
+    /// The four foot geoms (FL, FR, BL, BR).
+    pub foot_geoms: [usize; 4],
+}
+
+/// Loads `path` and finds the layout the hardware needs.
+pub fn load(path: &Path) -> Result<(MjModel, Layout), ModelError> {
+    let model = MjModel::from_xml(path).map_err(|e| ModelError::Load {
+        path: path.to_owned(),
+        message: e.to_string(),
+    })?;
+    let layout = Layout::find(&model, path)?;
+    Ok((model, layout))
+}
+
+impl Layout {
+    fn find(model: &MjModel, path: &Path) -> Result<Self, ModelError> {
+        let id = |kind: &'static str, obj: MjtObj, name: &str| {
+            model
+                .name_to_id(obj, name)
+                .ok_or_else(|| ModelError::Missing {
+                    path: path.to_owned(),
+                    kind,
+                    name: name.to_owned(),
+                })
+        };
+        let joint = |name: &str| id("joint", MjtObj::mjOBJ_JOINT, name);
+        let actuator = |name: &str| id("actuator", MjtObj::mjOBJ_ACTUATOR, name);
+        let sensor = |name: &str| {
+            id("sensor", MjtObj::mjOBJ_SENSOR, name).map(|s| model.sensor_adr()[s] as usize)
+        };
+        let geom = |name: &str| id("geom", MjtObj::mjOBJ_GEOM, name);
+        let qpos = |j: usize| model.jnt_qposadr()[j] as usize;
+        let qvel = |j: usize| model.jnt_dofadr()[j] as usize;
+
+        let mut layout = Layout {
+            leg_qpos: [0; 16],
+            leg_qvel: [0; 16],
+            leg_actuator: [0; 16],
+            leg_group: [0; 4],
+            wheel_qpos: [0; 2],
+            wheel_qvel: [0; 2],
+            wheel_actuator: [0; 2],
+            leg_force_sensor: [0; 16],
+            wheel_force_sensor: [0; 2],
+            imu_quat: sensor("imu_quat")?,
+            imu_gyro: sensor("imu_gyro")?,
+            imu_accel: sensor("imu_accel")?,
+            foot_touch: [0; 4],
+            torso_body: id("body", MjtObj::mjOBJ_BODY, "torso")?,
+            wheel_geoms: [geom("wheel_left")?, geom("wheel_right")?],
+            foot_geoms: [0; 4],
+        };
+        for (i, name) in JOINT_NAMES.iter().enumerate() {
+            let j = joint(name)?;
+            layout.leg_qpos[i] = qpos(j);
+            layout.leg_qvel[i] = qvel(j);
+            layout.leg_actuator[i] = actuator(&format!("m_{name}"))?;
+            layout.leg_force_sensor[i] = sensor(&format!("frc_{name}"))?;
+        }
+        for (leg, suffix) in ["fl", "fr", "bl", "br"].into_iter().enumerate() {
+            layout.leg_group[leg] = model.actuator_group()[layout.leg_actuator[4 * leg]] as u32;
+            layout.foot_touch[leg] = sensor(&format!("touch_{suffix}"))?;
+            layout.foot_geoms[leg] = geom(&format!("foot_{suffix}"))?;
+        }
+        for (i, side) in WHEEL_NAMES.iter().enumerate() {
+            let j = joint(&format!("wheel_{side}_joint"))?;
+            layout.wheel_qpos[i] = qpos(j);
+            layout.wheel_qvel[i] = qvel(j);
+            layout.wheel_actuator[i] = actuator(&format!("m_wheel_{side}"))?;
+            layout.wheel_force_sensor[i] = sensor(&format!("frc_wheel_{side}"))?;
+        }
+        Ok(layout)
+    }
+}
+
+/// Geom ids of the obstacle scene's `step` and `ramp`; `None` in a scene without them.
+pub fn obstacle_ids(physics: &crate::physics::Physics) -> Option<Vec<usize>> {
+    let model = physics.model();
+    ["step", "ramp"]
+        .iter()
+        .map(|name| model.name_to_id(MjtObj::mjOBJ_GEOM, name))
+        .collect()
+}

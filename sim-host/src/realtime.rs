@@ -1,0 +1,69 @@
+//! Real time: the simulator steps on the wall clock at the control rate, takes whatever frames
+//! arrived since the last cycle, and sends the nodes' feedback. No SYNC: the controller keeps
+//! its own time, as on the robot. Reports the real-time factor and counts overruns (cycles that
+//! ended after their deadline).
+
+use std::time::{Duration, Instant};
+
+use crate::bus::Bus;
+use crate::recorder::Recorder;
+use crate::run_stats::{RunError, RunStats};
+use crate::simulator::Simulator;
+
+/// Real-time settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RealtimeOptions {
+    /// Control cycles to run.
+    pub cycles: u64,
+    /// Length of a cycle on the wall clock.
+    pub period: Duration,
+}
+
+/// Runs `options.cycles` cycles on the wall clock. `peers(cycle)` runs right after the
+/// simulator has sent its feedback (see [`crate::lockstep::run`]); `observe` after each cycle.
+pub fn run(
+    sim: &mut Simulator,
+    bus: &mut dyn Bus,
+    recorder: &mut Recorder,
+    options: RealtimeOptions,
+    mut peers: impl FnMut(u32) -> Result<(), RunError>,
+    mut observe: impl FnMut(&Simulator) -> bool,
+) -> Result<RunStats, RunError> {
+    let started = Instant::now();
+    let mut stats = RunStats::default();
+    for n in 0..options.cycles {
+        let wall_s = started.elapsed().as_secs_f64();
+        while let Some(frame) = bus.recv(Duration::ZERO)? {
+            stats.frames_received += 1;
+            recorder.frame(wall_s, &frame)?;
+            sim.receive(&frame);
+        }
+        sim.advance();
+        stats.cycles += 1;
+        if !sim.physics().is_finite() {
+            return Err(RunError::Diverged {
+                time_s: sim.time_s(),
+            });
+        }
+        for frame in sim.frames_due()? {
+            bus.send(&frame)?;
+            recorder.frame(started.elapsed().as_secs_f64(), &frame)?;
+            stats.frames_sent += 1;
+        }
+        peers(sim.cycle())?;
+        recorder.row(sim.telemetry());
+        if !observe(sim) {
+            break;
+        }
+        let deadline = started + options.period.mul_f64((n + 1) as f64);
+        let now = Instant::now();
+        if now > deadline {
+            stats.overruns += 1;
+        } else {
+            std::thread::sleep(deadline - now);
+        }
+    }
+    stats.sim_s = sim.time_s();
+    stats.set_wall(started.elapsed());
+    Ok(stats)
+}

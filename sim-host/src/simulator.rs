@@ -1,0 +1,151 @@
+//! The simulated robot: MuJoCo physics plus the emulated CAN nodes, advanced one control cycle
+//! at a time. Bus- and clock-agnostic: [`crate::lockstep`] and [`crate::realtime`] move frames
+//! between it and a [`crate::bus::Bus`].
+
+use std::path::Path;
+
+use protocol::{EncodeError, Frame};
+
+use crate::hardware::Hardware;
+use crate::imu::ImuNoise;
+use crate::model::ModelError;
+use crate::physics::Physics;
+use crate::telemetry::TelemetryRow;
+
+/// How the simulation starts.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StartPose {
+    /// Torso centre height, m.
+    pub height_m: f64,
+    /// Leg joint angles, [`protocol::JOINT_NAMES`] order, rad.
+    pub leg_joint_rad: [f64; 16],
+}
+
+impl StartPose {
+    /// Standing on the firmware's nominal stance (feet 0.35 m below the hips), feet just on the
+    /// ground.
+    pub fn standing() -> Self {
+        let config = firmware::config::Config::ROBOT;
+        let posture = config.posture;
+        let depth_m = posture.depth_nominal_m;
+        let leg = posture
+            .stance(&config.geometry, &config.limits, depth_m)
+            .map(|j| j.to_array())
+            .unwrap_or([0.0; 4]);
+        let mut leg_joint_rad = [0.0; 16];
+        for (i, angle) in leg_joint_rad.iter_mut().enumerate() {
+            *angle = f64::from(leg[i % 4]);
+        }
+        Self {
+            height_m: f64::from(depth_m) + FOOT_RADIUS_M,
+            leg_joint_rad,
+        }
+    }
+}
+
+/// Foot sphere radius in the model, m.
+pub const FOOT_RADIUS_M: f64 = 0.035;
+
+/// The simulated robot.
+#[derive(Debug)]
+pub struct Simulator {
+    physics: Physics,
+    hardware: Hardware,
+    steps_per_cycle: u32,
+    cycle_us: u64,
+    cycle: u32,
+    now_us: u64,
+}
+
+impl Simulator {
+    /// Loads `model`, places the robot at `start` and sets the nodes up for a controller at
+    /// `control_hz`. The model's timestep must divide the control period.
+    pub fn new(
+        model: &Path,
+        control_hz: u32,
+        start: StartPose,
+        imu_noise: ImuNoise,
+    ) -> Result<Self, ModelError> {
+        let mut physics = Physics::load(model)?;
+        let timestep_s = physics.timestep_s();
+        let period_s = 1.0 / f64::from(control_hz.max(1));
+        let ratio = period_s / timestep_s;
+        let steps = ratio.round();
+        if !(1.0..=1000.0).contains(&steps) || (ratio - steps).abs() > 1e-6 {
+            return Err(ModelError::Timestep {
+                path: model.to_owned(),
+                timestep_s,
+                period_s,
+            });
+        }
+        physics.place(start.height_m, &start.leg_joint_rad);
+        Ok(Self {
+            physics,
+            hardware: Hardware::new(control_hz, imu_noise),
+            steps_per_cycle: steps as u32,
+            cycle_us: (period_s * 1e6).round() as u64,
+            cycle: 0,
+            now_us: 0,
+        })
+    }
+
+    /// The physics (ground truth).
+    pub fn physics(&self) -> &Physics {
+        &self.physics
+    }
+
+    /// The emulated nodes.
+    pub fn hardware(&self) -> &Hardware {
+        &self.hardware
+    }
+
+    /// The control cycle about to run.
+    pub fn cycle(&self) -> u32 {
+        self.cycle
+    }
+
+    /// Simulation time, µs (integer, so that long runs do not drift).
+    pub fn now_us(&self) -> u64 {
+        self.now_us
+    }
+
+    /// Simulation time, s.
+    pub fn time_s(&self) -> f64 {
+        self.now_us as f64 * 1e-6
+    }
+
+    /// Hands a received frame to the nodes.
+    pub fn receive(&mut self, frame: &Frame) {
+        self.hardware.on_frame(self.now_us, frame);
+    }
+
+    /// The frames the nodes send at the start of this cycle (feedback, IMU, status).
+    pub fn frames_due(&mut self) -> Result<Vec<Frame>, EncodeError> {
+        self.hardware
+            .frames_due(self.now_us, self.cycle, &self.physics)
+    }
+
+    /// Applies the drives' commands and steps the physics through one control period.
+    pub fn advance(&mut self) {
+        self.hardware.apply(self.now_us, &mut self.physics);
+        for _ in 0..self.steps_per_cycle {
+            self.physics.step();
+        }
+        self.cycle = self.cycle.wrapping_add(1);
+        self.now_us += self.cycle_us;
+    }
+
+    /// Telemetry of the current state.
+    pub fn telemetry(&self) -> TelemetryRow {
+        let torso = self.physics.torso();
+        TelemetryRow {
+            time_s: self.time_s(),
+            torso_pos_m: torso.pos_m,
+            torso_rpy_deg: torso.rpy_rad().map(f64::to_degrees),
+            leg_joint_rad: self.physics.leg_positions_rad(),
+            wheel_torque_nm: self.hardware.wheel_torque_nm(self.now_us),
+            wheel_speed_rad_s: self.physics.wheel_velocities_rad_s(),
+            mode: self.hardware.controller_mode(),
+        }
+    }
+}

@@ -1,0 +1,151 @@
+//! The bus over Linux SocketCAN (`vcan0`, `can0`), through the `socketcan` crate, in CAN FD mode.
+//! Classic CAN data frames are accepted too (a `cansend 123#…` from a shell); error, remote and
+//! extended-id frames are counted as foreign and skipped.
+
+use std::io::ErrorKind;
+use std::path::Path;
+use std::time::Duration;
+
+use socketcan::{CanAnyFrame, CanFdFrame, CanFdSocket, EmbeddedFrame, Id, Socket, StandardId};
+
+use protocol::Frame;
+
+use crate::bus::{Bus, BusError};
+
+/// A node on a SocketCAN interface.
+#[derive(Debug)]
+pub struct SocketCanBus {
+    socket: CanFdSocket,
+    ifname: String,
+    foreign: u64,
+}
+
+impl SocketCanBus {
+    /// Opens `ifname` for CAN FD frames. A missing, down or classic-only interface is a
+    /// [`BusError`] that says how to fix it.
+    pub fn open(ifname: &str) -> Result<Self, BusError> {
+        let sys = Path::new("/sys/class/net").join(ifname);
+        if !sys.exists() {
+            return Err(BusError::NoSuchInterface {
+                ifname: ifname.to_owned(),
+            });
+        }
+        let read = |file: &str| std::fs::read_to_string(sys.join(file)).unwrap_or_default();
+        // 16 = classic CAN only; 72 = CAN FD.
+        if read("mtu").trim() == "16" {
+            return Err(BusError::NotFd {
+                ifname: ifname.to_owned(),
+            });
+        }
+        if !read("flags").trim().is_empty() {
+            let flags =
+                u32::from_str_radix(read("flags").trim().trim_start_matches("0x"), 16).unwrap_or(1);
+            // IFF_UP
+            if flags & 1 == 0 {
+                return Err(BusError::InterfaceDown {
+                    ifname: ifname.to_owned(),
+                });
+            }
+        }
+        let socket = CanFdSocket::open(ifname).map_err(|source| classify(ifname, source))?;
+        Ok(Self {
+            socket,
+            ifname: ifname.to_owned(),
+            foreign: 0,
+        })
+    }
+}
+
+// Linux errno values (x86_64 and arm share them).
+const ENODEV: i32 = 19;
+const EPROTONOSUPPORT: i32 = 93;
+const EAFNOSUPPORT: i32 = 97;
+const ENETDOWN: i32 = 100;
+const ENOBUFS: i32 = 105;
+
+fn classify(ifname: &str, source: std::io::Error) -> BusError {
+    let ifname = ifname.to_owned();
+    match source.raw_os_error() {
+        Some(ENODEV) => BusError::NoSuchInterface { ifname },
+        Some(EAFNOSUPPORT | EPROTONOSUPPORT) => BusError::NoCanSupport { ifname, source },
+        Some(ENETDOWN) => BusError::InterfaceDown { ifname },
+        _ => BusError::Io { ifname, source },
+    }
+}
+
+impl Bus for SocketCanBus {
+    fn send(&mut self, frame: &Frame) -> Result<(), BusError> {
+        let id = StandardId::new(frame.id()).ok_or_else(|| BusError::Io {
+            ifname: self.ifname.clone(),
+            source: std::io::Error::new(ErrorKind::InvalidInput, "not an 11-bit id"),
+        })?;
+        let fd = CanFdFrame::new(id, frame.data()).ok_or_else(|| BusError::Io {
+            ifname: self.ifname.clone(),
+            source: std::io::Error::new(ErrorKind::InvalidInput, "not a CAN FD length"),
+        })?;
+        loop {
+            match self.socket.write_frame(&fd) {
+                Ok(()) => return Ok(()),
+                // The interface's transmit queue is full: wait for it to drain.
+                Err(e) if e.raw_os_error() == Some(ENOBUFS) => {
+                    std::thread::sleep(Duration::from_micros(100));
+                }
+                Err(e) => return Err(classify(&self.ifname, e)),
+            }
+        }
+    }
+
+    fn recv(&mut self, timeout: Duration) -> Result<Option<Frame>, BusError> {
+        loop {
+            let any = match self.socket.read_frame_timeout(timeout) {
+                Ok(frame) => frame,
+                Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock) => {
+                    return Ok(None)
+                }
+                Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                Err(e) => return Err(classify(&self.ifname, e)),
+            };
+            let converted = match &any {
+                CanAnyFrame::Fd(f) => standard(f.id()).and_then(|id| Frame::new(id, f.data())),
+                CanAnyFrame::Normal(f) => standard(f.id()).and_then(|id| Frame::new(id, f.data())),
+                _ => None,
+            };
+            match converted {
+                Some(frame) => return Ok(Some(frame)),
+                None => self.foreign += 1,
+            }
+        }
+    }
+
+    fn foreign_frames(&self) -> u64 {
+        self.foreign
+    }
+
+    fn name(&self) -> &str {
+        &self.ifname
+    }
+}
+
+fn standard(id: Id) -> Option<u16> {
+    match id {
+        Id::Standard(id) => Some(id.as_raw()),
+        Id::Extended(_) => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_missing_interface_says_how_to_create_it() {
+        let err = SocketCanBus::open("vcan-missing7").unwrap_err();
+        assert!(matches!(err, BusError::NoSuchInterface { .. }), "{err:?}");
+        let text = err.to_string();
+        assert!(text.contains("sudo modprobe vcan"), "{text}");
+        assert!(
+            text.contains("ip link add vcan-missing7 type vcan"),
+            "{text}"
+        );
+    }
+}

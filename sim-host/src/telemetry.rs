@@ -1,0 +1,32 @@
+//! What the simulator records each step for the user: ground truth from MuJoCo and what the
+//! bus said, one [`TelemetryRow`] per recorded step.
+
+use protocol::ControllerMode;
+
+/// One recorded simulation step. Angles are ground truth from the simulator, not estimates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TelemetryRow {
+    /// Simulation time, s.
+    pub time_s: f64,
+    /// Torso centre in the world frame (x forward at start, z up), m.
+    pub torso_pos_m: [f64; 3],
+    /// Torso roll, pitch (+ = nose down), yaw (+ = turning left), degrees.
+    pub torso_rpy_deg: [f64; 3],
+    /// Leg joint angles in [`protocol::JOINT_NAMES`] order, rad.
+    pub leg_joint_rad: [f64; 16],
+    /// Wheel torques applied by the wheel drive, left and right, N·m (+ = forward).
+    pub wheel_torque_nm: [f64; 2],
+    /// Wheel speeds, left and right, rad/s (+ = rolling forward).
+    pub wheel_speed_rad_s: [f64; 2],
+    /// The controller's mode from its last status frame, `None` before the first.
+    pub mode: Option<ControllerMode>,
+}
+
+/// A frame seen on the bus, for the candump log.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoggedFrame {
+    /// When it was seen: simulation time in lockstep, wall time since start in real time, s.
+    pub time_s: f64,
+    /// The frame.
+    pub frame: protocol::Frame,
+}

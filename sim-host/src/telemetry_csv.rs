@@ -1,0 +1,158 @@
+//! Telemetry as a CSV file: one header line, then one line per [`TelemetryRow`].
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::Path;
+
+use protocol::JOINT_NAMES;
+
+use crate::output_error::OutputError;
+use crate::telemetry::TelemetryRow;
+
+/// The CSV's column names, in order: time, torso position and attitude, one `<joint>_rad`
+/// column per leg joint in [`JOINT_NAMES`] order, wheel torques and speeds, controller mode.
+pub fn header() -> Vec<String> {
+    let leading = [
+        "time_s",
+        "torso_x_m",
+        "torso_y_m",
+        "torso_z_m",
+        "roll_deg",
+        "pitch_deg",
+        "yaw_deg",
+    ];
+    let trailing = [
+        "wheel_left_torque_nm",
+        "wheel_right_torque_nm",
+        "wheel_left_speed_rad_s",
+        "wheel_right_speed_rad_s",
+        "mode",
+    ];
+    let joints = JOINT_NAMES.iter().map(|joint| format!("{joint}_rad"));
+    leading
+        .iter()
+        .map(|name| (*name).to_owned())
+        .chain(joints)
+        .chain(trailing.iter().map(|name| (*name).to_owned()))
+        .collect()
+}
+
+/// Writes `rows` to `path` (created or truncated) under [`header`]. Numbers are written in
+/// their shortest exact decimal form (`NaN` and `inf` as such); the mode is its
+/// [`protocol::ControllerMode::label`], or empty before the first controller status. No rows
+/// gives a file with only the header.
+pub fn write_csv(path: &Path, rows: &[TelemetryRow]) -> Result<(), OutputError> {
+    let file = File::create(path).map_err(|source| io_error(path, source))?;
+    let mut writer = csv::Writer::from_writer(BufWriter::new(file));
+    let csv_error = |source| OutputError::Csv {
+        path: path.to_path_buf(),
+        source,
+    };
+    let header = header();
+    writer.write_record(&header).map_err(csv_error)?;
+    let mut record = Vec::with_capacity(header.len());
+    for row in rows {
+        record.clear();
+        record.push(row.time_s.to_string());
+        let numbers = row
+            .torso_pos_m
+            .iter()
+            .chain(&row.torso_rpy_deg)
+            .chain(&row.leg_joint_rad)
+            .chain(&row.wheel_torque_nm)
+            .chain(&row.wheel_speed_rad_s);
+        record.extend(numbers.map(f64::to_string));
+        record.push(row.mode.map_or("", |mode| mode.label()).to_owned());
+        writer.write_record(&record).map_err(csv_error)?;
+    }
+    let mut inner = writer
+        .into_inner()
+        .map_err(|error| io_error(path, error.into_error()))?;
+    inner.flush().map_err(|source| io_error(path, source))
+}
+
+fn io_error(path: &Path, source: std::io::Error) -> OutputError {
+    OutputError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use protocol::ControllerMode;
+
+    fn row(time_s: f64, mode: Option<ControllerMode>) -> TelemetryRow {
+        let mut leg_joint_rad = [0.0; 16];
+        for (i, angle) in leg_joint_rad.iter_mut().enumerate() {
+            *angle = i as f64 * 0.01;
+        }
+        TelemetryRow {
+            time_s,
+            torso_pos_m: [1.5, -0.25, 0.3],
+            torso_rpy_deg: [0.5, -2.0, 90.0],
+            leg_joint_rad,
+            wheel_torque_nm: [0.75, -0.125],
+            wheel_speed_rad_s: [10.0, 11.0],
+            mode,
+        }
+    }
+
+    #[test]
+    fn header_names_every_column_in_order() {
+        let header = header();
+        assert_eq!(header.len(), 7 + 16 + 5);
+        assert_eq!(header[0], "time_s");
+        assert_eq!(header[6], "yaw_deg");
+        assert_eq!(header[7], "hip1_fl_rad");
+        assert_eq!(header[22], "ankle_br_rad");
+        assert_eq!(header[23], "wheel_left_torque_nm");
+        assert_eq!(header[27], "mode");
+    }
+
+    #[test]
+    fn writes_header_and_one_line_per_row() {
+        let dir = std::env::temp_dir().join(format!("telemetry_csv_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("telemetry.csv");
+        let rows = [
+            row(0.0, None),
+            row(0.004, Some(ControllerMode::WheelForward)),
+            row(0.008, Some(ControllerMode::Stop)),
+        ];
+        write_csv(&path, &rows).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), rows.len() + 1);
+        assert_eq!(lines[0], header().join(","));
+        assert_eq!(lines[0].split(',').count(), 28);
+        assert!(lines[1].starts_with("0,1.5,-0.25,0.3,0.5,-2,90,0,0.01,"));
+        assert!(lines[1].ends_with(",0.75,-0.125,10,11,"));
+        assert!(lines[2].starts_with("0.004,"));
+        assert!(lines[2].ends_with(",WheelForward"));
+        assert!(lines[3].ends_with(",Stop"));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn no_rows_gives_only_the_header() {
+        let dir = std::env::temp_dir().join(format!("telemetry_csv_empty_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("empty.csv");
+        write_csv(&path, &[]).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text, format!("{}\n", header().join(",")));
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn unwritable_path_is_an_io_error_naming_the_file() {
+        let path = Path::new("/nonexistent-dir-for-test/telemetry.csv");
+        let error = write_csv(path, &[row(0.0, None)]).unwrap_err();
+        assert!(matches!(&error, OutputError::Io { path: p, .. } if p == path));
+        assert!(error
+            .to_string()
+            .contains("/nonexistent-dir-for-test/telemetry.csv"));
+    }
+}

@@ -1,0 +1,84 @@
+//! The wheel drive: two torque-controlled motors (the report's motor actuators, gear 1) that
+//! take `WheelCommand` frames and report angle, speed and torque in `WheelFeedback`.
+
+use protocol::{
+    AnyMessage, E2eCounter, Frame, MessageId, Torque, WheelAngle, WheelFeedback, WheelVelocity,
+};
+
+use crate::drive_core::{Authority, DriveCore};
+use crate::physics::Physics;
+
+/// The emulated wheel drive.
+#[derive(Debug, Clone)]
+pub struct WheelDrive {
+    core: DriveCore,
+    torque_nm: [f64; 2],
+    feedback_counter: E2eCounter,
+}
+
+impl Default for WheelDrive {
+    fn default() -> Self {
+        Self {
+            core: DriveCore::new(MessageId::WheelCommand),
+            torque_nm: [0.0; 2],
+            feedback_counter: E2eCounter::default(),
+        }
+    }
+}
+
+impl WheelDrive {
+    /// Receive state, counters and flags.
+    pub fn core(&self) -> &DriveCore {
+        &self.core
+    }
+
+    /// Mutable access for the status frame.
+    pub fn core_mut(&mut self) -> &mut DriveCore {
+        &mut self.core
+    }
+
+    /// Takes a frame from the bus (see [`DriveCore::on_frame`]).
+    pub fn on_frame(&mut self, now_us: u64, frame: &Frame) {
+        if let Some(AnyMessage::WheelCommand(command)) = self.core.on_frame(now_us, frame) {
+            self.torque_nm = command.torque.map(|t| f64::from(t.si()));
+            self.core.set_commanded_enable(true);
+        }
+    }
+
+    /// The torques the motors apply for the next step: the command, or zero when the drive is
+    /// torque-off (timeout, E-stop, no command yet).
+    pub fn applied_torque_nm(&self, now_us: u64) -> [f64; 2] {
+        match self.core.authority(now_us) {
+            Authority::Drive => self.torque_nm,
+            Authority::TorqueOff => [0.0; 2],
+        }
+    }
+
+    /// Drives the wheel motors in the simulation for the next step.
+    pub fn apply(&self, now_us: u64, physics: &mut Physics) {
+        physics.set_wheel_torques(self.applied_torque_nm(now_us));
+    }
+
+    /// The feedback frame for the current state.
+    pub fn feedback(&mut self, physics: &Physics) -> AnyMessage {
+        let wrap = |a: f64| {
+            (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
+        };
+        AnyMessage::WheelFeedback(WheelFeedback {
+            position: physics
+                .wheel_positions_rad()
+                .map(|a| WheelAngle::saturating_from_si(wrap(a) as f32)),
+            velocity: physics
+                .wheel_velocities_rad_s()
+                .map(|v| WheelVelocity::saturating_from_si(v as f32)),
+            effort: physics
+                .wheel_efforts_nm()
+                .map(|t| Torque::saturating_from_si(t as f32)),
+        })
+    }
+
+    /// The rolling counter for the next feedback frame.
+    pub fn next_feedback_counter(&mut self) -> u16 {
+        self.feedback_counter.advance()
+    }
+}
