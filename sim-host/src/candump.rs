@@ -331,7 +331,8 @@ mod tests {
     #[test]
     fn malformed_lines_give_their_cause() {
         use CandumpParseError as E;
-        let cases: [(&str, fn(&E) -> bool); 18] = [
+        type IsExpected = fn(&E) -> bool;
+        let cases: [(&str, IsExpected); 18] = [
             ("", |e| *e == E::MissingTimestamp),
             ("vcan0 123##4", |e| *e == E::MissingTimestamp),
             ("(1.0 vcan0 123##4", |e| *e == E::MissingTimestamp),

@@ -7,7 +7,7 @@
 
 use std::time::{Duration, Instant};
 
-use protocol::{AnyMessage, E2eCounter, MessageId, Sync, Tick};
+use protocol::MessageId;
 
 use crate::bus::Bus;
 use crate::recorder::Recorder;
@@ -37,22 +37,16 @@ pub fn run(
 ) -> Result<RunStats, RunError> {
     let started = Instant::now();
     let mut stats = RunStats::default();
-    let mut sync_counter = E2eCounter::default();
     for _ in 0..options.cycles {
-        let cycle = sim.cycle();
         let time_s = sim.time_s();
-        let sync = AnyMessage::Sync(Sync {
-            tick: Tick::from_raw(cycle).unwrap_or(Tick::saturating_from_si(0.0)),
-        })
-        .encode(sync_counter.advance())?;
-        let mut outgoing = vec![sync];
+        let mut outgoing = vec![sim.sync_frame()?];
         outgoing.extend(sim.frames_due()?);
         for frame in &outgoing {
             bus.send(frame)?;
             recorder.frame(time_s, frame)?;
             stats.frames_sent += 1;
         }
-        peers(cycle)?;
+        peers(sim.cycle())?;
         let deadline = Instant::now() + options.reply_timeout;
         let mut commanded = false;
         loop {

@@ -16,15 +16,41 @@ use crate::telemetry::TelemetryRow;
 /// Width and height of every figure, pixels.
 pub const SIZE: (u32, u32) = (1000, 500);
 
-/// The file names [`write_plots`] writes, in order.
-pub const FILE_NAMES: [&str; 4] = [
-    "wheel_torque.png",
-    "front_left_joints.png",
-    "torso_trajectory.png",
-    "torso_height.png",
-];
+/// One figure and the file it is written to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Figure {
+    WheelTorque,
+    FrontLeftJoints,
+    TorsoTrajectory,
+    TorsoHeight,
+}
+
+impl Figure {
+    const ALL: [Figure; 4] = [
+        Figure::WheelTorque,
+        Figure::FrontLeftJoints,
+        Figure::TorsoTrajectory,
+        Figure::TorsoHeight,
+    ];
+
+    const fn file_name(self) -> &'static str {
+        match self {
+            Figure::WheelTorque => "wheel_torque.png",
+            Figure::FrontLeftJoints => "front_left_joints.png",
+            Figure::TorsoTrajectory => "torso_trajectory.png",
+            Figure::TorsoHeight => "torso_height.png",
+        }
+    }
+}
 
 const FONT: &str = "sans-serif";
+const TITLE_PX: u32 = 22;
+const TEXT_PX: u32 = 14;
+const MARGIN_PX: u32 = 10;
+const X_LABELS_PX: u32 = 40;
+const Y_LABELS_PX: u32 = 70;
+const LINE_PX: u32 = 2;
+const LEGEND_LINE_PX: i32 = 20;
 const COLORS: [RGBColor; 4] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
@@ -34,8 +60,11 @@ const COLORS: [RGBColor; 4] = [
 
 type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::ErrorType>>;
 
-/// Draws the four figures of `rows` as [`SIZE`] PNGs named [`FILE_NAMES`] in `dir` (created if
-/// missing, files overwritten) and returns their paths in that order. Non-finite values are
+/// Draws the four figures of `rows` as [`SIZE`] PNGs in `dir` (created if missing, files
+/// overwritten) and returns their paths in this order: `wheel_torque.png` (left and right wheel
+/// torque), `front_left_joints.png` (the four front-left joint angles, degrees),
+/// `torso_trajectory.png` (x–y top view, start and end marked), `torso_height.png` (height,
+/// then pitch and roll). Non-finite values are
 /// left out of the lines. Fails with [`OutputError::NoRows`] if `rows` is empty, and with
 /// [`OutputError::Io`] or [`OutputError::Plot`] naming the directory or figure that failed.
 pub fn write_plots(dir: &Path, rows: &[TelemetryRow]) -> Result<Vec<PathBuf>, OutputError> {
@@ -46,22 +75,26 @@ pub fn write_plots(dir: &Path, rows: &[TelemetryRow]) -> Result<Vec<PathBuf>, Ou
         path: dir.to_path_buf(),
         source,
     })?;
-    let mut written = Vec::with_capacity(FILE_NAMES.len());
-    for name in FILE_NAMES {
-        let path = dir.join(name);
-        let plot_error = |message: String| OutputError::Plot {
+    let mut written = Vec::with_capacity(Figure::ALL.len());
+    for figure in Figure::ALL {
+        let path = dir.join(figure.file_name());
+        render(&path, figure, rows).map_err(|message| OutputError::Plot {
             path: path.clone(),
             message,
-        };
-        register_fonts().map_err(|message| plot_error(message.to_owned()))?;
-        let root = BitMapBackend::new(&path, SIZE).into_drawing_area();
-        root.fill(&WHITE)
-            .and_then(|()| draw(name, &root, rows))
-            .and_then(|()| root.present())
-            .map_err(|error| plot_error(error.to_string()))?;
+        })?;
         written.push(path);
     }
     Ok(written)
+}
+
+/// Draws `figure` into the PNG `path`, or says why it could not.
+fn render(path: &Path, figure: Figure, rows: &[TelemetryRow]) -> Result<(), String> {
+    register_fonts().map_err(str::to_owned)?;
+    let root = BitMapBackend::new(path, SIZE).into_drawing_area();
+    root.fill(&WHITE)
+        .and_then(|()| draw(figure, &root, rows))
+        .and_then(|()| root.present())
+        .map_err(|error| error.to_string())
 }
 
 /// Registers the bundled DejaVu Sans as plotters' `sans-serif`, once per process.
@@ -74,7 +107,7 @@ fn register_fonts() -> Result<(), &'static str> {
 }
 
 fn draw<DB: DrawingBackend>(
-    name: &str,
+    figure: Figure,
     root: &DrawingArea<DB, Shift>,
     rows: &[TelemetryRow],
 ) -> DrawResult<DB> {
@@ -84,15 +117,15 @@ fn draw<DB: DrawingBackend>(
         color,
         points: rows.iter().map(|row| (row.time_s, value(row))).collect(),
     };
-    match name {
-        "wheel_torque.png" => {
+    match figure {
+        Figure::WheelTorque => {
             let lines = [
                 series("left", COLORS[0], |row| row.wheel_torque_nm[0]),
                 series("right", COLORS[1], |row| row.wheel_torque_nm[1]),
             ];
             time_chart(root, "Wheel torque", "torque (N·m)", &lines, &modes)
         }
-        "front_left_joints.png" => {
+        Figure::FrontLeftJoints => {
             let lines = protocol::JOINT_NAMES
                 .iter()
                 .enumerate()
@@ -113,8 +146,8 @@ fn draw<DB: DrawingBackend>(
             let title = "Front-left leg joint angles";
             time_chart(root, title, "angle (deg)", &lines, &modes)
         }
-        "torso_trajectory.png" => trajectory_chart(root, rows),
-        _ => {
+        Figure::TorsoTrajectory => trajectory_chart(root, rows),
+        Figure::TorsoHeight => {
             let (upper, lower) = root.split_vertically(SIZE.1 / 2);
             let height = [series("z", COLORS[0], |row| row.torso_pos_m[2])];
             time_chart(&upper, "Torso height", "height (m)", &height, &modes)?;
@@ -145,14 +178,14 @@ struct ModeSpan {
 /// The modes of `rows`, each from its first row to the next mode's first row (or the last
 /// row). Rows without a mode start no span.
 fn mode_spans(rows: &[TelemetryRow]) -> Vec<ModeSpan> {
-    let end_s = rows.last().map_or(0.0, |row| row.time_s);
+    let end_s = rows.last().map_or(0.0_f64, |row| row.time_s);
     let mut spans: Vec<ModeSpan> = Vec::new();
     let mut current = None;
     for row in rows {
         if row.mode == current {
             continue;
         }
-        if let Some(last) = spans.last_mut() {
+        if let (Some(_), Some(last)) = (current, spans.last_mut()) {
             last.end_s = row.time_s;
         }
         current = row.mode;
@@ -177,16 +210,16 @@ fn time_chart<DB: DrawingBackend>(
     let time = axis_range(lines.iter().flat_map(|line| &line.points).map(|p| p.0), 0.0);
     let values = axis_range(lines.iter().flat_map(|line| &line.points).map(|p| p.1), 0.05);
     let mut chart = ChartBuilder::on(area)
-        .caption(title, (FONT, 22))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
+        .caption(title, (FONT, TITLE_PX))
+        .margin(MARGIN_PX)
+        .x_label_area_size(X_LABELS_PX)
+        .y_label_area_size(Y_LABELS_PX)
         .build_cartesian_2d(time.clone(), values.clone())?;
     chart
         .configure_mesh()
         .x_desc("time (s)")
         .y_desc(y_desc)
-        .label_style((FONT, 14))
+        .label_style((FONT, TEXT_PX))
         .draw()?;
     let (plot_width, _) = chart.plotting_area().dim_in_pixel();
     let seconds_per_pixel = (time.end - time.start) / f64::from(plot_width.max(1));
@@ -201,19 +234,19 @@ fn time_chart<DB: DrawingBackend>(
         }
     }
     for line in lines {
-        let style = line.color.stroke_width(2);
+        let style = line.color.stroke_width(LINE_PX);
         let finite = line.points.iter().copied().filter(|p| p.1.is_finite());
         chart
             .draw_series(LineSeries::new(finite, style))?
             .label(line.label)
-            .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
+            .legend(move |(x, y)| PathElement::new([(x, y), (x + LEGEND_LINE_PX, y)], style));
     }
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperRight)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .label_font((FONT, 14))
+        .label_font((FONT, TEXT_PX))
         .draw()
 }
 
@@ -234,22 +267,22 @@ fn trajectory_chart<DB: DrawingBackend>(
     let scale = ((x.end - x.start) / plot.0).max((y.end - y.start) / plot.1);
     let (x, y) = (widen(x, scale * plot.0), widen(y, scale * plot.1));
     let mut chart = ChartBuilder::on(area)
-        .caption("Torso trajectory (top view)", (FONT, 22))
-        .margin(10)
-        .x_label_area_size(40)
-        .y_label_area_size(70)
+        .caption("Torso trajectory (top view)", (FONT, TITLE_PX))
+        .margin(MARGIN_PX)
+        .x_label_area_size(X_LABELS_PX)
+        .y_label_area_size(Y_LABELS_PX)
         .build_cartesian_2d(x, y)?;
     chart
         .configure_mesh()
         .x_desc("x (m)")
         .y_desc("y (m)")
-        .label_style((FONT, 14))
+        .label_style((FONT, TEXT_PX))
         .draw()?;
-    let style = COLORS[0].stroke_width(2);
+    let style = COLORS[0].stroke_width(LINE_PX);
     chart
         .draw_series(LineSeries::new(points.iter().copied(), style))?
         .label("torso")
-        .legend(move |(x, y)| PathElement::new([(x, y), (x + 20, y)], style));
+        .legend(move |(x, y)| PathElement::new([(x, y), (x + LEGEND_LINE_PX, y)], style));
     let ends = [("start", points.first(), COLORS[2]), ("end", points.last(), COLORS[1])];
     for (label, point, color) in ends {
         if let Some(&point) = point {
@@ -264,7 +297,7 @@ fn trajectory_chart<DB: DrawingBackend>(
         .position(SeriesLabelPosition::UpperRight)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
-        .label_font((FONT, 14))
+        .label_font((FONT, TEXT_PX))
         .draw()
 }
 
@@ -349,7 +382,17 @@ mod tests {
     }
 
     fn assert_pngs(dir: &Path, written: &[PathBuf]) {
-        let expected: Vec<PathBuf> = FILE_NAMES.iter().map(|name| dir.join(name)).collect();
+        let names = Figure::ALL.map(Figure::file_name);
+        assert_eq!(
+            names,
+            [
+                "wheel_torque.png",
+                "front_left_joints.png",
+                "torso_trajectory.png",
+                "torso_height.png"
+            ]
+        );
+        let expected: Vec<PathBuf> = names.iter().map(|name| dir.join(name)).collect();
         assert_eq!(written, expected);
         for path in written {
             let (width, height, colours) = decode(path);
@@ -416,9 +459,10 @@ mod tests {
     #[test]
     fn axis_ranges_are_never_empty() {
         assert_eq!(axis_range([0.0, 10.0].into_iter(), 0.05), -0.5..10.5);
-        assert_eq!(axis_range([2.0, 2.0].into_iter(), 0.05), 1.8..2.2);
-        assert_eq!(axis_range([f64::NAN].into_iter(), 0.05), -0.1..0.1);
-        assert_eq!(axis_range(std::iter::empty(), 0.0), -0.1..0.1);
+        assert_eq!(axis_range([10.0, 10.0].into_iter(), 0.05), 9.0..11.0);
+        assert_eq!(axis_range([0.0].into_iter(), 0.05), -0.1..0.1);
+        assert_eq!(axis_range([f64::NAN].into_iter(), 0.05), -1.0..1.0);
+        assert_eq!(axis_range(std::iter::empty(), 0.0), -1.0..1.0);
         assert_eq!(widen(0.0..1.0, 3.0), -1.0..2.0);
         assert_eq!(widen(0.0..1.0, 0.5), 0.0..1.0);
     }

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use protocol::{EncodeError, Frame};
+use protocol::{AnyMessage, E2eCounter, EncodeError, Frame, Sync, Tick};
 
 use crate::hardware::Hardware;
 use crate::imu::ImuNoise;
@@ -55,6 +55,7 @@ pub struct Simulator {
     cycle_us: u64,
     cycle: u32,
     now_us: u64,
+    sync_counter: E2eCounter,
 }
 
 impl Simulator {
@@ -86,6 +87,7 @@ impl Simulator {
             cycle_us: (period_s * 1e6).round() as u64,
             cycle: 0,
             now_us: 0,
+            sync_counter: E2eCounter::default(),
         })
     }
 
@@ -117,6 +119,14 @@ impl Simulator {
     /// Hands a received frame to the nodes.
     pub fn receive(&mut self, frame: &Frame) {
         self.hardware.on_frame(self.now_us, frame);
+    }
+
+    /// The lockstep SYNC frame of this cycle: the tick the controller should compute.
+    pub fn sync_frame(&mut self) -> Result<Frame, EncodeError> {
+        AnyMessage::Sync(Sync {
+            tick: Tick::from_raw(self.cycle).unwrap_or(Tick::saturating_from_si(0.0)),
+        })
+        .encode(self.sync_counter.advance())
     }
 
     /// The frames the nodes send at the start of this cycle (feedback, IMU, status).

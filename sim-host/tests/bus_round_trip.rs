@@ -1,0 +1,382 @@
+//! The emulated drives and IMU on the in-process bus, driven by a hand-written controller that
+//! speaks only CAN frames: targets go out, feedback comes back, and the drives behave as real
+//! ones do on timeouts, corrupted frames and E-stops.
+
+use std::cell::RefCell;
+use std::path::Path;
+use std::rc::Rc;
+use std::time::Duration;
+
+use protocol::{
+    Angle, AnyMessage, DriveEnable, DriveFlags, DriveStatus, E2eCounter, EStop, EStopAction, Frame,
+    Leg, LegFeedback, LegTargets, NodeId, Receiver, Torque, WheelCommand, WheelFeedback,
+};
+use sim_host::bus::Bus;
+use sim_host::imu::ImuNoise;
+use sim_host::inproc_bus::{InprocBus, InprocEndpoint};
+use sim_host::lockstep::{self, LockstepOptions};
+use sim_host::model::DEFAULT_MODEL;
+use sim_host::recorder::Recorder;
+use sim_host::simulator::{Simulator, StartPose};
+
+const HZ: u32 = 250;
+
+/// What the test controller does each cycle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Plan {
+    /// Send leg targets and wheel torques.
+    Command,
+    /// Send nothing.
+    Silent,
+}
+
+/// A minimal controller: sends fixed targets, keeps the latest feedback and status.
+struct TestController {
+    bus: InprocEndpoint,
+    receiver: Receiver,
+    leg_counter: E2eCounter,
+    wheel_counter: E2eCounter,
+    targets_rad: [f32; 16],
+    wheel_torque_nm: [f32; 2],
+    plan: Plan,
+    extra: Vec<Frame>,
+    sent: Vec<Frame>,
+    leg_feedback: [Option<LegFeedback>; 4],
+    wheel_feedback: Option<WheelFeedback>,
+    imu_gyro: Vec<[f32; 3]>,
+    drive_status: [Option<DriveStatus>; 5],
+    feedback_frames: u64,
+}
+
+impl TestController {
+    fn new(bus: InprocEndpoint) -> Self {
+        let start = StartPose::standing();
+        Self {
+            bus,
+            receiver: Receiver::default(),
+            leg_counter: E2eCounter::default(),
+            wheel_counter: E2eCounter::default(),
+            targets_rad: start.leg_joint_rad.map(|a| a as f32),
+            wheel_torque_nm: [0.0; 2],
+            plan: Plan::Command,
+            extra: Vec::new(),
+            sent: Vec::new(),
+            leg_feedback: [None; 4],
+            wheel_feedback: None,
+            imu_gyro: Vec::new(),
+            drive_status: [None; 5],
+            feedback_frames: 0,
+        }
+    }
+
+    fn service(&mut self) {
+        while let Some(frame) = self.bus.recv(Duration::ZERO).unwrap() {
+            let accepted = self
+                .receiver
+                .receive(frame.id(), frame.data())
+                .unwrap_or_else(|e| panic!("the simulator sent a bad frame {frame:?}: {e:?}"));
+            match accepted.message {
+                AnyMessage::LegFeedback(leg, fb) => {
+                    self.leg_feedback[leg as usize] = Some(fb);
+                    self.feedback_frames += 1;
+                }
+                AnyMessage::WheelFeedback(fb) => {
+                    self.wheel_feedback = Some(fb);
+                    self.feedback_frames += 1;
+                }
+                AnyMessage::Imu(imu) => self.imu_gyro.push(imu.angular_rate.map(|r| r.si())),
+                AnyMessage::DriveStatus(drive, status) => {
+                    self.drive_status[drive as usize] = Some(status)
+                }
+                _ => {}
+            }
+        }
+        for frame in self.extra.drain(..) {
+            self.bus.send(&frame).unwrap();
+        }
+        if self.plan == Plan::Command {
+            let legs = AnyMessage::LegTargets(LegTargets {
+                enable: DriveEnable::Enabled,
+                position: self.targets_rad.map(Angle::saturating_from_si),
+            })
+            .encode(self.leg_counter.advance())
+            .unwrap();
+            let wheels = AnyMessage::WheelCommand(WheelCommand {
+                torque: self.wheel_torque_nm.map(Torque::saturating_from_si),
+            })
+            .encode(self.wheel_counter.advance())
+            .unwrap();
+            for frame in [legs, wheels] {
+                self.bus.send(&frame).unwrap();
+                self.sent.push(frame);
+            }
+        }
+    }
+}
+
+fn setup() -> (Simulator, InprocEndpoint, Rc<RefCell<TestController>>) {
+    let sim = Simulator::new(
+        Path::new(DEFAULT_MODEL),
+        HZ,
+        StartPose::standing(),
+        ImuNoise::default(),
+    )
+    .unwrap();
+    let bus = InprocBus::new();
+    let sim_bus = bus.endpoint();
+    let controller = Rc::new(RefCell::new(TestController::new(bus.endpoint())));
+    (sim, sim_bus, controller)
+}
+
+/// Runs `cycles` lockstep cycles; returns how many cycles missed their command.
+fn run(
+    sim: &mut Simulator,
+    bus: &mut InprocEndpoint,
+    controller: &Rc<RefCell<TestController>>,
+    cycles: u64,
+    mut each: impl FnMut(&Simulator),
+) -> u64 {
+    let mut recorder = Recorder::in_memory();
+    let stats = lockstep::run(
+        sim,
+        bus,
+        &mut recorder,
+        LockstepOptions {
+            cycles,
+            reply_timeout: Duration::ZERO,
+        },
+        |_| {
+            controller.borrow_mut().service();
+            Ok(())
+        },
+        |s| {
+            each(s);
+            true
+        },
+    )
+    .unwrap();
+    stats.missed_cycles
+}
+
+#[test]
+fn leg_drives_servo_to_the_frames_targets_and_report_every_cycle() {
+    let (mut sim, mut bus, ctl) = setup();
+    // Abduct the front-left leg by 0.15 rad and bend its knee 0.1 rad more.
+    {
+        let mut c = ctl.borrow_mut();
+        c.targets_rad[0] += 0.15;
+        c.targets_rad[2] -= 0.10;
+    }
+    let wanted = {
+        let c = ctl.borrow();
+        [c.targets_rad[0], c.targets_rad[2]]
+    };
+    let missed = run(&mut sim, &mut bus, &ctl, HZ as u64, |_| {});
+    assert_eq!(missed, 0, "every cycle the command arrived");
+    let c = ctl.borrow();
+    // 250 cycles × (4 legs + wheels) of feedback, all accepted.
+    assert!(
+        c.feedback_frames >= 250 * 5 - 5,
+        "{} feedback frames",
+        c.feedback_frames
+    );
+    assert_eq!(c.receiver.counters().rejected.map(|n| n.raw()), [0; 6]);
+    assert_eq!(c.receiver.counters().lost.raw(), 0);
+    let fl = c.leg_feedback[0].expect("front-left feedback");
+    let got = [fl.position[0].si(), fl.position[2].si()];
+    for (g, w) in got.iter().zip(wanted) {
+        assert!(
+            (g - w).abs() < 0.03,
+            "joint at {g:.4} rad, target {w:.4} rad"
+        );
+    }
+    // The physics agrees with the feedback (to the wire's 1e-4 rad).
+    let truth = sim.physics().leg_positions_rad();
+    assert!((truth[0] as f32 - got[0]).abs() < 2e-4);
+    // Every drive reports itself enabled and counts the commands it took.
+    for (i, status) in c.drive_status.iter().enumerate() {
+        let status = status.unwrap_or_else(|| panic!("no status from drive {i}"));
+        assert!(
+            status.flags.contains(DriveFlags::ENABLED),
+            "drive {i}: {status:?}"
+        );
+        assert!(status.commands.raw() > 200, "drive {i}: {status:?}");
+    }
+    // The robot still stands.
+    let z = sim.physics().torso().pos_m[2];
+    assert!(z > 0.35, "torso at {z:.3} m");
+}
+
+#[test]
+fn the_wheel_drive_applies_the_commanded_torque_and_reports_it() {
+    let (mut sim, mut bus, ctl) = setup();
+    ctl.borrow_mut().wheel_torque_nm = [1.5, -1.5];
+    run(&mut sim, &mut bus, &ctl, HZ as u64 / 2, |_| {});
+    let c = ctl.borrow();
+    let fb = c.wheel_feedback.expect("wheel feedback");
+    let effort = fb.effort.map(|t| t.si());
+    assert!(
+        (effort[0] - 1.5).abs() < 0.011 && (effort[1] + 1.5).abs() < 0.011,
+        "{effort:?}"
+    );
+    // Standing on its legs, the wheels spin freely in opposite directions, up to the speed
+    // where the report's joint damping (2 N·m·s/rad) eats the torque: 1.5 / 2 = 0.75 rad/s.
+    let speed = fb.velocity.map(|v| v.si());
+    assert!(
+        (speed[0] - 0.75).abs() < 0.03 && (speed[1] + 0.75).abs() < 0.03,
+        "{speed:?}"
+    );
+}
+
+#[test]
+fn drives_go_torque_free_100_ms_after_the_last_command_and_say_so() {
+    let (mut sim, mut bus, ctl) = setup();
+    ctl.borrow_mut().wheel_torque_nm = [2.0, 2.0];
+    run(&mut sim, &mut bus, &ctl, 50, |_| {});
+    let last_command_us = sim.now_us() - 4_000;
+    ctl.borrow_mut().plan = Plan::Silent;
+    let mut off_at_us = None;
+    run(&mut sim, &mut bus, &ctl, 100, |s| {
+        let wheels_off = s.hardware().wheel_torque_nm(s.now_us()) == [0.0; 2];
+        let legs_off = (0..4).all(|leg| !s.physics().leg_enabled(leg));
+        if off_at_us.is_none() && wheels_off && legs_off {
+            off_at_us = Some(s.now_us());
+        }
+    });
+    let off_after_ms =
+        (off_at_us.expect("the drives never went torque-free") - last_command_us) as f64 / 1000.0;
+    assert!(
+        (100.0..=104.0).contains(&off_after_ms),
+        "torque off {off_after_ms} ms after the last command"
+    );
+    let c = ctl.borrow();
+    for (i, status) in c.drive_status.iter().enumerate() {
+        let status = status.unwrap();
+        assert!(
+            status.flags.contains(DriveFlags::TIMED_OUT),
+            "drive {i}: {status:?}"
+        );
+        assert!(
+            !status.flags.contains(DriveFlags::ENABLED),
+            "drive {i}: {status:?}"
+        );
+    }
+    // Torque-free legs cannot carry the torso: it sinks onto its wheels.
+    assert!(sim.physics().torso().pos_m[2] < 0.33);
+}
+
+#[test]
+fn corrupted_and_replayed_commands_are_rejected_counted_and_never_applied() {
+    let (mut sim, mut bus, ctl) = setup();
+    // Settle first, so that the only thing that could move the hips is the bad frame.
+    run(&mut sim, &mut bus, &ctl, 250, |_| {});
+    let before = sim.physics().leg_positions_rad()[1];
+    // A corrupted frame that would swing every hip forward by 0.5 rad.
+    let mut evil_targets = ctl.borrow().targets_rad;
+    for leg in 0..4 {
+        evil_targets[4 * leg + 1] += 0.5;
+    }
+    let evil = AnyMessage::LegTargets(LegTargets {
+        enable: DriveEnable::Enabled,
+        position: evil_targets.map(Angle::saturating_from_si),
+    })
+    .encode(ctl.borrow_mut().leg_counter.advance())
+    .unwrap();
+    let mut flipped = evil.data().to_vec();
+    flipped[7] ^= 0x10;
+    let corrupted = Frame::new(evil.id(), &flipped).unwrap();
+    let replayed = ctl.borrow().sent[10];
+    {
+        let mut c = ctl.borrow_mut();
+        c.plan = Plan::Silent;
+        c.extra = vec![corrupted, replayed];
+    }
+    run(&mut sim, &mut bus, &ctl, 1, |_| {});
+    ctl.borrow_mut().plan = Plan::Command;
+    run(&mut sim, &mut bus, &ctl, 50, |_| {});
+    let after = sim.physics().leg_positions_rad()[1];
+    assert!(
+        (after - before).abs() < 0.02,
+        "hip moved {before:.3} → {after:.3}"
+    );
+    // Each leg drive rejected both frames; the wheel drive ignores leg frames.
+    assert_eq!(sim.hardware().rejected(), 4 * 2);
+    for leg in sim.hardware().legs() {
+        assert_eq!(leg.core().rejected(), 2, "{:?}", leg.leg());
+    }
+    let status = ctl.borrow().drive_status[Leg::Fl as usize].unwrap();
+    assert_eq!(status.rejected.raw(), 2);
+}
+
+#[test]
+fn an_e_stop_frame_stops_every_drive_until_it_is_cleared() {
+    let (mut sim, mut bus, ctl) = setup();
+    ctl.borrow_mut().wheel_torque_nm = [3.0, 3.0];
+    run(&mut sim, &mut bus, &ctl, 25, |_| {});
+    let estop = |action, counter| {
+        AnyMessage::EStop(EStop {
+            action,
+            source: NodeId::Tool,
+        })
+        .encode(counter)
+        .unwrap()
+    };
+    ctl.borrow_mut().extra = vec![estop(EStopAction::Latch, 0)];
+    let mut stopped_within_cycles = None;
+    let mut n = 0;
+    run(&mut sim, &mut bus, &ctl, 50, |s| {
+        n += 1;
+        let off = s.hardware().wheel_torque_nm(s.now_us()) == [0.0; 2]
+            && (0..4).all(|leg| !s.physics().leg_enabled(leg));
+        if off && stopped_within_cycles.is_none() {
+            stopped_within_cycles = Some(n);
+        }
+        if stopped_within_cycles.is_some() {
+            assert!(off, "a drive restarted while the E-stop is latched");
+        }
+    });
+    assert_eq!(
+        stopped_within_cycles,
+        Some(1),
+        "the drives stop in the cycle of the E-stop"
+    );
+    for status in ctl.borrow().drive_status {
+        assert!(status.unwrap().flags.contains(DriveFlags::ESTOP));
+    }
+    ctl.borrow_mut().extra = vec![estop(EStopAction::Clear, 1)];
+    run(&mut sim, &mut bus, &ctl, 30, |_| {});
+    assert_eq!(sim.hardware().wheel_torque_nm(sim.now_us()), [3.0, 3.0]);
+    assert!((0..4).all(|leg| sim.physics().leg_enabled(leg)));
+}
+
+#[test]
+fn the_imu_is_ideal_by_default_and_noisy_when_asked() {
+    let (mut sim, mut bus, ctl) = setup();
+    run(&mut sim, &mut bus, &ctl, 250, |_| {});
+    let still: Vec<_> = ctl.borrow().imu_gyro[125..].to_vec();
+    let spread = |samples: &[[f32; 3]]| {
+        let n = samples.len() as f32;
+        let mean = samples.iter().map(|s| s[0]).sum::<f32>() / n;
+        let var = samples.iter().map(|s| (s[0] - mean).powi(2)).sum::<f32>() / n;
+        (mean, var.sqrt())
+    };
+    let (_, quiet) = spread(&still);
+    assert!(quiet < 0.01, "a still robot's ideal gyro: std {quiet}");
+
+    let noise = ImuNoise {
+        gyro_std_rad_s: 0.05,
+        gyro_bias_rad_s: [0.2, 0.0, 0.0],
+        seed: 7,
+        ..ImuNoise::default()
+    };
+    let mut sim =
+        Simulator::new(Path::new(DEFAULT_MODEL), HZ, StartPose::standing(), noise).unwrap();
+    let bus_all = InprocBus::new();
+    let mut sim_bus = bus_all.endpoint();
+    let ctl = Rc::new(RefCell::new(TestController::new(bus_all.endpoint())));
+    run(&mut sim, &mut sim_bus, &ctl, 250, |_| {});
+    let noisy: Vec<_> = ctl.borrow().imu_gyro[125..].to_vec();
+    let (mean, std) = spread(&noisy);
+    assert!((mean - 0.2).abs() < 0.02, "bias: mean {mean}");
+    assert!((std - 0.05).abs() < 0.015, "noise: std {std}");
+}
