@@ -1,1 +1,239 @@
-fn main() {}
+//! `sim-host`: the hybrid wheel–leg robot in MuJoCo, playing its leg drives, wheel drive and IMU
+//! on a CAN bus.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Duration;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use protocol::TeleopMode;
+use sim_host::imu::ImuNoise;
+use sim_host::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
+use sim_host::scripted_teleop::PlanStep;
+use sim_host::session::{self, BusChoice, Clock, SessionConfig};
+
+/// The hybrid wheel–leg robot in MuJoCo, on a CAN bus.
+///
+/// The simulator plays the robot's hardware: four leg drives (position servos), a wheel drive
+/// (torque) and a torso IMU, each a CAN node with the project's frames, E2E checks and a 100 ms
+/// command timeout. On the in-process bus the firmware's control core runs beside it; on a
+/// SocketCAN interface the controller is another process.
+#[derive(Debug, Parser)]
+#[command(version, about, long_about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run the simulation.
+    ///
+    /// Example: sim-host run --duration 10 --drive 0:stand --drive 2:W --out out/sim
+    Run(RunArgs),
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum Mode {
+    /// The simulator sends SYNC each cycle, waits for the controller, then steps:
+    /// deterministic, faster than real time.
+    Lockstep,
+    /// Steps on the wall clock at the control rate; reports real-time factor and overruns.
+    Realtime,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum Scene {
+    /// Flat ground.
+    Flat,
+    /// A 6 cm step at 1.5 m and a 10° ramp from 3 m.
+    Obstacles,
+}
+
+#[derive(Debug, clap::Args)]
+struct RunArgs {
+    /// `inproc` (the firmware runs in this process) or a SocketCAN interface such as `vcan0`.
+    #[arg(long, default_value = "inproc")]
+    bus: String,
+    /// Clock.
+    #[arg(long, value_enum, default_value = "lockstep")]
+    mode: Mode,
+    /// Simulated seconds to run.
+    #[arg(long, default_value_t = 10.0)]
+    duration: f64,
+    /// Folder for telemetry.csv, bus.log (candump format) and the PNG plots.
+    #[arg(long, default_value = "out/sim")]
+    out: PathBuf,
+    /// Which shipped scene to load.
+    #[arg(long, value_enum, default_value = "flat")]
+    scene: Scene,
+    /// An MJCF file instead of a shipped scene.
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// Operator command at a time, `SECONDS:MODE` with MODE one of the report's keys W S A L K X
+    /// or `stand` / `fold`; repeat for a sequence. Without it no teleop node is on the bus and
+    /// the controller holds the robot where it stands.
+    #[arg(long = "drive", value_parser = parse_step)]
+    drive: Vec<PlanStep>,
+    /// Control rate, Hz (the model's timestep must divide the period).
+    #[arg(long, default_value_t = 250)]
+    control_hz: u32,
+    /// Lockstep: how long to wait for the controller's command each cycle, ms.
+    #[arg(long, default_value_t = 100)]
+    reply_timeout_ms: u64,
+    /// IMU gyro white noise, standard deviation, rad/s.
+    #[arg(long, default_value_t = 0.0)]
+    gyro_noise: f64,
+    /// IMU gyro bias on every axis, rad/s.
+    #[arg(long, default_value_t = 0.0)]
+    gyro_bias: f64,
+    /// IMU accelerometer white noise, standard deviation, m/s².
+    #[arg(long, default_value_t = 0.0)]
+    accel_noise: f64,
+    /// Seed of the IMU noise.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Skip the PNG plots.
+    #[arg(long)]
+    no_plots: bool,
+    /// Open the interactive MuJoCo viewer (build with `--features viewer`).
+    #[arg(long)]
+    viewer: bool,
+}
+
+fn parse_step(text: &str) -> Result<PlanStep, String> {
+    let (time, mode) = text
+        .split_once(':')
+        .ok_or_else(|| format!("`{text}`: expected SECONDS:MODE, e.g. 2:W"))?;
+    let seconds: f64 = time
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{time}` is not a number of seconds"))?;
+    if !(0.0..=1e6).contains(&seconds) {
+        return Err(format!("`{time}`: time must be 0…1e6 s"));
+    }
+    let mode = match mode.trim().to_ascii_lowercase().as_str() {
+        "stand" => TeleopMode::Stand,
+        "fold" => TeleopMode::Fold,
+        key if key.chars().count() == 1 => key
+            .chars()
+            .next()
+            .and_then(TeleopMode::from_key)
+            .ok_or_else(|| format!("`{mode}`: use W S A L K X, stand or fold"))?,
+        _ => return Err(format!("`{mode}`: use W S A L K X, stand or fold")),
+    };
+    Ok(PlanStep {
+        at_us: (seconds * 1e6).round() as u64,
+        mode,
+        body_height_m: 0.0,
+        speed_scale_pct: 100.0,
+    })
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Run(args) => match run(args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(message) => {
+                eprintln!("sim-host: {message}");
+                ExitCode::FAILURE
+            }
+        },
+    }
+}
+
+fn run(args: RunArgs) -> Result<(), String> {
+    if args.viewer && !cfg!(feature = "viewer") {
+        return Err(
+            "this sim-host was built without the viewer: cargo run -p sim-host --features viewer -- run --viewer …"
+                .into(),
+        );
+    }
+    if !(args.duration.is_finite() && args.duration > 0.0) {
+        return Err(format!(
+            "--duration {} must be a positive number of seconds",
+            args.duration
+        ));
+    }
+    let model = args.model.unwrap_or_else(|| {
+        PathBuf::from(match args.scene {
+            Scene::Flat => DEFAULT_MODEL,
+            Scene::Obstacles => OBSTACLES_MODEL,
+        })
+    });
+    let bus = match args.bus.as_str() {
+        "inproc" => BusChoice::Inproc,
+        ifname => BusChoice::SocketCan(ifname.to_owned()),
+    };
+    let config = SessionConfig {
+        model,
+        bus,
+        clock: match args.mode {
+            Mode::Lockstep => Clock::Lockstep,
+            Mode::Realtime => Clock::Realtime,
+        },
+        duration_s: args.duration,
+        control_hz: args.control_hz,
+        reply_timeout: Duration::from_millis(args.reply_timeout_ms),
+        imu_noise: ImuNoise {
+            gyro_std_rad_s: args.gyro_noise,
+            gyro_bias_rad_s: [args.gyro_bias; 3],
+            accel_std_m_s2: args.accel_noise,
+            seed: args.seed,
+            ..ImuNoise::default()
+        },
+        teleop_plan: args.drive,
+        out_dir: Some(args.out.clone()),
+        plots: !args.no_plots,
+        progress: true,
+    };
+    tracing::info!(model = %config.model.display(), bus = %args.bus, "starting");
+    let report = session::run(&config).map_err(|e| e.to_string())?;
+    let s = report.stats;
+    let last = report.rows.last();
+    println!(
+        "simulated        {:.2} s in {:.2} s wall ({:.1}x real time)",
+        s.sim_s,
+        s.wall_s,
+        s.real_time_factor()
+    );
+    println!(
+        "cycles           {} ({} missed, {} overruns)",
+        s.cycles, s.missed_cycles, s.overruns
+    );
+    println!(
+        "frames           {} sent, {} received",
+        s.frames_sent, s.frames_received
+    );
+    println!(
+        "rejected         {} by the drives{}",
+        report.drives_rejected,
+        report
+            .firmware_rejected
+            .map(|n| format!(", {n} by the firmware"))
+            .unwrap_or_default()
+    );
+    if let Some(row) = last {
+        println!(
+            "torso at end     x {:.3} m, y {:.3} m, z {:.3} m, roll {:.1}°, pitch {:.1}°, yaw {:.1}°",
+            row.torso_pos_m[0],
+            row.torso_pos_m[1],
+            row.torso_pos_m[2],
+            row.torso_rpy_deg[0],
+            row.torso_rpy_deg[1],
+            row.torso_rpy_deg[2]
+        );
+    }
+    for file in &report.files {
+        println!("wrote            {}", file.display());
+    }
+    Ok(())
+}

@@ -51,6 +51,7 @@ const X_LABELS_PX: u32 = 40;
 const Y_LABELS_PX: u32 = 70;
 const LINE_PX: u32 = 2;
 const LEGEND_LINE_PX: i32 = 20;
+const MARKER_PX: u32 = 6;
 const COLORS: [RGBColor; 4] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
@@ -149,7 +150,7 @@ fn draw<DB: DrawingBackend>(
         Figure::TorsoTrajectory => trajectory_chart(root, rows),
         Figure::TorsoHeight => {
             let (upper, lower) = root.split_vertically(SIZE.1 / 2);
-            let height = [series("z", COLORS[0], |row| row.torso_pos_m[2])];
+            let height = [series("torso z", COLORS[0], |row| row.torso_pos_m[2])];
             time_chart(&upper, "Torso height", "height (m)", &height, &modes)?;
             let attitude = [
                 series("pitch (+ nose down)", COLORS[1], |row| row.torso_rpy_deg[1]),
@@ -208,7 +209,10 @@ fn time_chart<DB: DrawingBackend>(
     modes: &[ModeSpan],
 ) -> DrawResult<DB> {
     let time = axis_range(lines.iter().flat_map(|line| &line.points).map(|p| p.0), 0.0);
-    let values = axis_range(lines.iter().flat_map(|line| &line.points).map(|p| p.1), 0.05);
+    let values = axis_range(
+        lines.iter().flat_map(|line| &line.points).map(|p| p.1),
+        0.05,
+    );
     let mut chart = ChartBuilder::on(area)
         .caption(title, (FONT, TITLE_PX))
         .margin(MARGIN_PX)
@@ -224,12 +228,14 @@ fn time_chart<DB: DrawingBackend>(
     let (plot_width, _) = chart.plotting_area().dim_in_pixel();
     let seconds_per_pixel = (time.end - time.start) / f64::from(plot_width.max(1));
     for (index, span) in modes.iter().enumerate() {
-        let shade = if index % 2 == 0 { 0.04 } else { 0.10 };
+        let shade = if index % 2 == 0 { 0.04_f64 } else { 0.10_f64 };
         let band = [(span.start_s, values.start), (span.end_s, values.end)];
         chart.draw_series([Rectangle::new(band, BLACK.mix(shade).filled())])?;
-        let label_px = 8.0 * span.label.len() as f64 + 8.0;
+        // About 8 px per character at this size, plus the inset.
+        let label_px = 8.0_f64 * (span.label.len() as f64 + 1.0_f64);
         if (span.end_s - span.start_s) / seconds_per_pixel >= label_px {
-            let text = Text::new(span.label, (4, 4), (FONT, 13).into_font().color(&BLACK));
+            let inset: (i32, i32) = (4, 4);
+            let text = Text::new(span.label, inset, (FONT, TEXT_PX).into_font().color(&BLACK));
             chart.draw_series([EmptyElement::at((span.start_s, values.end)) + text])?;
         }
     }
@@ -263,7 +269,11 @@ fn trajectory_chart<DB: DrawingBackend>(
     let y = axis_range(points.iter().map(|p| p.1), 0.05);
     // Same metres per pixel on both axes, from the plot area the layout below leaves.
     let (width, height) = area.dim_in_pixel();
-    let plot = (f64::from(width) - 100.0, f64::from(height) - 100.0);
+    let decorations_px = 100.0_f64;
+    let plot = (
+        f64::from(width) - decorations_px,
+        f64::from(height) - decorations_px,
+    );
     let scale = ((x.end - x.start) / plot.0).max((y.end - y.start) / plot.1);
     let (x, y) = (widen(x, scale * plot.0), widen(y, scale * plot.1));
     let mut chart = ChartBuilder::on(area)
@@ -283,13 +293,18 @@ fn trajectory_chart<DB: DrawingBackend>(
         .draw_series(LineSeries::new(points.iter().copied(), style))?
         .label("torso")
         .legend(move |(x, y)| PathElement::new([(x, y), (x + LEGEND_LINE_PX, y)], style));
-    let ends = [("start", points.first(), COLORS[2]), ("end", points.last(), COLORS[1])];
+    let ends = [
+        ("start", points.first(), COLORS[2]),
+        ("end", points.last(), COLORS[1]),
+    ];
     for (label, point, color) in ends {
         if let Some(&point) = point {
             chart
-                .draw_series([Circle::new(point, 6, color.filled())])?
+                .draw_series([Circle::new(point, MARKER_PX, color.filled())])?
                 .label(label)
-                .legend(move |(x, y)| Circle::new((x + 10, y), 5, color.filled()));
+                .legend(move |(x, y)| {
+                    Circle::new((x + LEGEND_LINE_PX / 2_i32, y), MARKER_PX, color.filled())
+                });
         }
     }
     chart
@@ -310,11 +325,11 @@ fn axis_range(values: impl Iterator<Item = f64>, pad: f64) -> Range<f64> {
             (low.min(value), high.max(value))
         });
     let span = high - low;
-    let range = if span > 1e-9 * low.abs().max(high.abs()).max(1.0) {
+    let range = if span > 1e-9_f64 * low.abs().max(high.abs()).max(1.0) {
         (low - pad * span)..(high + pad * span)
     } else {
-        let middle = (low + high) / 2.0;
-        let half = middle.abs().max(1.0) * 0.1;
+        let middle = (low + high) / 2.0_f64;
+        let half = middle.abs().max(1.0) * 0.1_f64;
         (middle - half)..(middle + half)
     };
     if range.start.is_finite() && range.end.is_finite() {
@@ -326,8 +341,8 @@ fn axis_range(values: impl Iterator<Item = f64>, pad: f64) -> Range<f64> {
 
 /// `range` widened about its middle to `span`, if that is wider.
 fn widen(range: Range<f64>, span: f64) -> Range<f64> {
-    let middle = (range.start + range.end) / 2.0;
-    let half = (span.max(range.end - range.start)) / 2.0;
+    let middle = (range.start + range.end) / 2.0_f64;
+    let half = span.max(range.end - range.start) / 2.0_f64;
     (middle - half)..(middle + half)
 }
 
@@ -439,7 +454,12 @@ mod tests {
     #[test]
     fn mode_spans_cover_each_mode_until_the_next() {
         let mut rows = rows(6);
-        let modes = [None, Some(ControllerMode::Stop), Some(ControllerMode::Stop), None];
+        let modes = [
+            None,
+            Some(ControllerMode::Stop),
+            Some(ControllerMode::Stop),
+            None,
+        ];
         for (row, mode) in rows.iter_mut().zip(modes) {
             row.mode = mode;
         }

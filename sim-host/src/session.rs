@@ -1,0 +1,276 @@
+//! One complete simulator run as a user starts it: build the simulator, attach it to a bus
+//! (with the firmware in-process on the in-process bus), run it in lockstep or real time, and
+//! leave the telemetry CSV, the candump log and the plots in an output folder.
+
+use std::path::PathBuf;
+use std::time::Duration;
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::bus::{Bus, BusError};
+use crate::imu::ImuNoise;
+use crate::inproc_bus::InprocBus;
+use crate::inproc_controller::InprocController;
+use crate::lockstep::{self, LockstepOptions};
+use crate::model::ModelError;
+use crate::output_error::OutputError;
+use crate::realtime::{self, RealtimeOptions};
+use crate::recorder::Recorder;
+use crate::run_stats::{RunError, RunStats};
+use crate::scripted_teleop::{PlanStep, ScriptedTeleop};
+use crate::simulator::{Simulator, StartPose};
+use crate::socketcan_bus::SocketCanBus;
+use crate::telemetry::TelemetryRow;
+
+/// Which bus the simulator joins.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum BusChoice {
+    /// In-process, with the firmware's control core on it.
+    Inproc,
+    /// A SocketCAN interface; the controller is another process.
+    SocketCan(String),
+}
+
+/// Which clock drives the run.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Clock {
+    /// The simulator is the clock (SYNC frames); as fast as possible.
+    Lockstep,
+    /// The wall clock at the control rate.
+    Realtime,
+}
+
+/// Everything a run needs.
+#[derive(Debug, Clone)]
+pub struct SessionConfig {
+    /// The MJCF file.
+    pub model: PathBuf,
+    /// Bus.
+    pub bus: BusChoice,
+    /// Clock.
+    pub clock: Clock,
+    /// Simulated time to run, s.
+    pub duration_s: f64,
+    /// Control rate, Hz.
+    pub control_hz: u32,
+    /// Lockstep: how long to wait for the controller each cycle.
+    pub reply_timeout: Duration,
+    /// IMU noise.
+    pub imu_noise: ImuNoise,
+    /// Operator commands to send (empty: no teleop node on the bus).
+    pub teleop_plan: Vec<PlanStep>,
+    /// Where to write outputs (`None`: keep telemetry in memory only).
+    pub out_dir: Option<PathBuf>,
+    /// Whether to draw the PNG plots.
+    pub plots: bool,
+    /// Show a progress bar.
+    pub progress: bool,
+}
+
+/// Why a session failed.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum SessionError {
+    /// The model.
+    #[error(transparent)]
+    Model(#[from] ModelError),
+    /// The bus.
+    #[error(transparent)]
+    Bus(#[from] BusError),
+    /// The run.
+    #[error(transparent)]
+    Run(#[from] RunError),
+    /// An output file.
+    #[error(transparent)]
+    Output(#[from] OutputError),
+    /// The control rate is not one the firmware runs at.
+    #[error("the firmware cannot run at {0} Hz (it needs 1…10000 Hz)")]
+    ControlRate(u32),
+    /// The firmware's configuration was rejected.
+    #[error("the firmware rejected its configuration: {0:?}")]
+    Firmware(firmware::controller::ConfigError),
+}
+
+/// What a session leaves behind.
+#[derive(Debug)]
+pub struct SessionReport {
+    /// Run counters.
+    pub stats: RunStats,
+    /// Every recorded cycle.
+    pub rows: Vec<TelemetryRow>,
+    /// Files written.
+    pub files: Vec<PathBuf>,
+    /// Frames the in-process firmware rejected (`None` over SocketCAN).
+    pub firmware_rejected: Option<u64>,
+    /// Frames the emulated drives rejected.
+    pub drives_rejected: u64,
+}
+
+/// Runs one session.
+pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
+    let mut sim = Simulator::new(
+        &config.model,
+        config.control_hz,
+        StartPose::standing(),
+        config.imu_noise,
+    )?;
+    let cycles = (config.duration_s * f64::from(config.control_hz))
+        .round()
+        .max(0.0) as u64;
+    let interface = match &config.bus {
+        BusChoice::Inproc => "vcan0".to_owned(),
+        BusChoice::SocketCan(ifname) => ifname.clone(),
+    };
+    let mut files = Vec::new();
+    let mut recorder = match &config.out_dir {
+        Some(dir) => {
+            std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
+                path: dir.clone(),
+                source,
+            })?;
+            let log = dir.join("bus.log");
+            files.push(log.clone());
+            Recorder::with_candump(&log, &interface)?
+        }
+        None => Recorder::in_memory(),
+    };
+    let progress = progress_bar(config.progress, cycles);
+    let mut observe = |s: &Simulator| {
+        if u64::from(s.cycle()) % 25 == 0 {
+            progress.set_position(u64::from(s.cycle()));
+        }
+        true
+    };
+    let mut teleop = ScriptedTeleop::new(config.teleop_plan.clone());
+    let has_teleop = !config.teleop_plan.is_empty();
+    let period_us = 1_000_000 / u64::from(config.control_hz.max(1));
+
+    let (stats, firmware_rejected) = match &config.bus {
+        BusChoice::Inproc => {
+            let bus = InprocBus::new();
+            let mut sim_bus = bus.endpoint();
+            let firmware = firmware_config(config.control_hz)
+                .ok_or(SessionError::ControlRate(config.control_hz))?;
+            let mut controller =
+                InprocController::new(firmware, bus.endpoint()).map_err(SessionError::Firmware)?;
+            let mut teleop_bus = bus.endpoint();
+            let peers = |cycle: u32| -> Result<(), RunError> {
+                if has_teleop {
+                    for frame in teleop.frames(u64::from(cycle) * period_us)? {
+                        teleop_bus.send(&frame)?;
+                    }
+                }
+                controller.service(cycle)?;
+                Ok(())
+            };
+            let stats = drive(
+                &mut sim,
+                &mut sim_bus,
+                &mut recorder,
+                config,
+                cycles,
+                peers,
+                &mut observe,
+            )?;
+            (stats, Some(controller.rejected()))
+        }
+        BusChoice::SocketCan(ifname) => {
+            let mut sim_bus = SocketCanBus::open(ifname)?;
+            let mut teleop_bus = if has_teleop {
+                Some(SocketCanBus::open(ifname)?)
+            } else {
+                None
+            };
+            let peers = |cycle: u32| -> Result<(), RunError> {
+                if let Some(bus) = &mut teleop_bus {
+                    for frame in teleop.frames(u64::from(cycle) * period_us)? {
+                        bus.send(&frame)?;
+                    }
+                }
+                Ok(())
+            };
+            let stats = drive(
+                &mut sim,
+                &mut sim_bus,
+                &mut recorder,
+                config,
+                cycles,
+                peers,
+                &mut observe,
+            )?;
+            (stats, None)
+        }
+    };
+    progress.finish_and_clear();
+    let drives_rejected = sim.hardware().rejected();
+    let rows = recorder.finish()?;
+    if let Some(dir) = &config.out_dir {
+        let csv = dir.join("telemetry.csv");
+        crate::telemetry_csv::write_csv(&csv, &rows)?;
+        files.push(csv);
+        if config.plots {
+            files.extend(crate::plots::write_plots(dir, &rows)?);
+        }
+    }
+    Ok(SessionReport {
+        stats,
+        rows,
+        files,
+        firmware_rejected,
+        drives_rejected,
+    })
+}
+
+fn drive(
+    sim: &mut Simulator,
+    bus: &mut dyn Bus,
+    recorder: &mut Recorder,
+    config: &SessionConfig,
+    cycles: u64,
+    peers: impl FnMut(u32) -> Result<(), RunError>,
+    observe: impl FnMut(&Simulator) -> bool,
+) -> Result<RunStats, RunError> {
+    match config.clock {
+        Clock::Lockstep => lockstep::run(
+            sim,
+            bus,
+            recorder,
+            LockstepOptions {
+                cycles,
+                reply_timeout: config.reply_timeout,
+            },
+            peers,
+            observe,
+        ),
+        Clock::Realtime => realtime::run(
+            sim,
+            bus,
+            recorder,
+            RealtimeOptions {
+                cycles,
+                period: Duration::from_secs_f64(1.0 / f64::from(config.control_hz.max(1))),
+            },
+            peers,
+            observe,
+        ),
+    }
+}
+
+/// The firmware's robot configuration at `control_hz`, `None` for a rate it cannot run.
+pub fn firmware_config(control_hz: u32) -> Option<firmware::config::Config> {
+    firmware::time::TickRate::new(control_hz)
+        .map(|rate| firmware::config::Config::ROBOT.at_rate(rate))
+}
+
+fn progress_bar(show: bool, cycles: u64) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(cycles);
+    if let Ok(style) = ProgressStyle::with_template(
+        "{spinner} simulating [{bar:30}] {percent:>3}% {elapsed} ({eta} left)",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
