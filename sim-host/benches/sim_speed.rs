@@ -1,1 +1,84 @@
-fn main() {}
+//! Simulation speed: raw MuJoCo steps of the robot model, and full closed-loop cycles (SYNC and
+//! feedback encoded, the firmware's control core decoding them and computing its commands, the
+//! drives decoding those, one MuJoCo step) on the in-process bus. `cargo xtask bench` prints
+//! both as steps per second.
+
+use std::path::Path;
+use std::time::Duration;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use protocol::TeleopMode;
+use sim_host::bus::Bus;
+use sim_host::imu::ImuNoise;
+use sim_host::inproc_bus::InprocBus;
+use sim_host::inproc_controller::InprocController;
+use sim_host::lockstep::{self, LockstepOptions};
+use sim_host::model::DEFAULT_MODEL;
+use sim_host::physics::Physics;
+use sim_host::recorder::Recorder;
+use sim_host::scripted_teleop::{PlanStep, ScriptedTeleop};
+use sim_host::session::firmware_config;
+use sim_host::simulator::{Simulator, StartPose};
+
+fn raw_step(c: &mut Criterion) {
+    let mut physics = Physics::load(Path::new(DEFAULT_MODEL)).expect("model");
+    let start = StartPose::standing();
+    physics.place(start.height_m, &start.leg_joint_rad);
+    let mut steps = 0u32;
+    c.bench_function("mujoco_step", |b| {
+        b.iter(|| {
+            // Restart now and then so that every sample measures a standing robot.
+            steps += 1;
+            if steps % 5_000 == 0 {
+                physics.place(start.height_m, &start.leg_joint_rad);
+            }
+            physics.step();
+        })
+    });
+}
+
+fn closed_loop(c: &mut Criterion) {
+    let start = StartPose::standing();
+    let mut sim =
+        Simulator::new(Path::new(DEFAULT_MODEL), 250, start, ImuNoise::default()).expect("model");
+    let bus = InprocBus::new();
+    let mut sim_bus = bus.endpoint();
+    let mut teleop_bus = bus.endpoint();
+    let mut controller =
+        InprocController::new(firmware_config(250).expect("250 Hz"), bus.endpoint())
+            .expect("firmware");
+    // Drive forward on the wheels: the balance loop, the IMU and the wheel drive all work.
+    let mut teleop = ScriptedTeleop::new(vec![PlanStep {
+        at_us: 0,
+        mode: TeleopMode::WheelForward,
+        body_height_m: 0.0,
+        speed_scale_pct: 100.0,
+    }]);
+    let mut recorder = Recorder::discarding();
+    let options = LockstepOptions {
+        cycles: 1,
+        reply_timeout: Duration::ZERO,
+    };
+    c.bench_function("closed_loop_cycle", |b| {
+        b.iter(|| {
+            lockstep::run(
+                &mut sim,
+                &mut sim_bus,
+                &mut recorder,
+                options,
+                |cycle| {
+                    for frame in teleop.frames(u64::from(cycle) * 4_000)? {
+                        teleop_bus.send(&frame)?;
+                    }
+                    controller.service(cycle)?;
+                    Ok(())
+                },
+                |_| true,
+            )
+            .expect("cycle")
+        })
+    });
+}
+
+criterion_group!(benches, raw_step, closed_loop);
+criterion_main!(benches);

@@ -65,8 +65,8 @@ type DrawResult<DB> = Result<(), DrawingAreaErrorKind<<DB as DrawingBackend>::Er
 /// overwritten) and returns their paths in this order: `wheel_torque.png` (left and right wheel
 /// torque), `front_left_joints.png` (the four front-left joint angles, degrees),
 /// `torso_trajectory.png` (x–y top view, start and end marked), `torso_height.png` (height,
-/// then pitch and roll). Non-finite values are
-/// left out of the lines. Fails with [`OutputError::NoRows`] if `rows` is empty, and with
+/// then pitch and roll). Time charts shade and name the controller's modes. Non-finite values
+/// are left out of the lines. Fails with [`OutputError::NoRows`] if `rows` is empty, and with
 /// [`OutputError::Io`] or [`OutputError::Plot`] naming the directory or figure that failed.
 pub fn write_plots(dir: &Path, rows: &[TelemetryRow]) -> Result<Vec<PathBuf>, OutputError> {
     if rows.is_empty() {
@@ -124,7 +124,13 @@ fn draw<DB: DrawingBackend>(
                 series("left", COLORS[0], |row| row.wheel_torque_nm[0]),
                 series("right", COLORS[1], |row| row.wheel_torque_nm[1]),
             ];
-            time_chart(root, "Wheel torque", "torque (N·m)", &lines, &modes)
+            time_chart(
+                root,
+                "Wheel torque",
+                "torque (N·m, + forward)",
+                &lines,
+                &modes,
+            )
         }
         Figure::FrontLeftJoints => {
             let lines = protocol::JOINT_NAMES

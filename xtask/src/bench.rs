@@ -1,14 +1,15 @@
 //! `cargo xtask bench`: the criterion benchmarks, then a table of their medians.
 //!
 //! Timings on shared machines are noisy: compare figures within one run (the ratio of the
-//! typed step to the full CAN node), not against a fixed number.
+//! typed step to the full CAN node, of the closed loop to raw MuJoCo), not against a fixed
+//! number.
 
 use std::fs;
 
 use crate::util::{cargo, root, run};
 
 /// Benchmarks reported, as `(criterion directory, what it measures)`.
-const REPORTED: [(&str, &str); 3] = [
+const REPORTED: [(&str, &str); 5] = [
     (
         "step_trot",
         "control step, trotting (4-leg IK + gait + FSM + safety)",
@@ -21,14 +22,26 @@ const REPORTED: [(&str, &str); 3] = [
         "node_trot",
         "CAN node tick, trotting (6 frames decoded + step + frames encoded)",
     ),
+    ("mujoco_step", "one MuJoCo step of the robot model (0.004 s)"),
+    (
+        "closed_loop_cycle",
+        "closed loop, driving on the wheels: sim frames + firmware + drives + 1 step, in-process bus",
+    ),
 ];
 
 pub fn run_task(args: &[String]) -> Result<(), String> {
-    let mut cmd = cargo();
-    cmd.args(["bench", "-p", "firmware", "--bench", "control_step", "--"]);
-    cmd.args(args);
-    run(&mut cmd)?;
-    println!("\n{:<12} {:>12}  measures", "benchmark", "median");
+    crate::setup::run()?;
+    for (package, bench) in [("firmware", "control_step"), ("sim-host", "sim_speed")] {
+        let mut cmd = cargo();
+        cmd.args(["bench", "-p", package, "--bench", bench, "--"]);
+        cmd.args(args);
+        run(&mut cmd)?;
+    }
+    println!(
+        "\n{:<18} {:>12} {:>14}  measures",
+        "benchmark", "median", "per second"
+    );
+    let mut medians = Vec::new();
     for (name, what) in REPORTED {
         let path = root()
             .join("target/criterion")
@@ -38,7 +51,20 @@ pub fn run_task(args: &[String]) -> Result<(), String> {
             .map_err(|e| format!("{}: {e} (did the benchmark run?)", path.display()))?;
         let median_ns = median_point_estimate(&text)
             .ok_or_else(|| format!("{}: no median estimate in the file", path.display()))?;
-        println!("{name:<12} {:>9.1} ns  {what}", median_ns);
+        println!(
+            "{name:<18} {:>9.1} ns {:>14.0}  {what}",
+            median_ns,
+            1e9 / median_ns
+        );
+        medians.push(median_ns);
+    }
+    if let [.., raw, closed] = medians[..] {
+        println!(
+            "\nclosed loop runs at {:.0} steps/s, {:.0} % of raw MuJoCo's {:.0} steps/s",
+            1e9 / closed,
+            100.0 * raw / closed,
+            1e9 / raw
+        );
     }
     Ok(())
 }

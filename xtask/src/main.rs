@@ -22,7 +22,8 @@ Tasks:
                      no_std crates, all tests, and a thumbv7em-none-eabihf build of the no_std crates
   dbc [--check]      regenerate protocol/hybrid_robot.dbc (--check: fail if the committed file is stale)
   busload            print the per-cycle frame schedule and the bus load at 250 Hz and 1 kHz
-  bench [args]       criterion benchmarks of the control step, then a table of medians
+  bench [args]       criterion benchmarks (control step, raw MuJoCo step, closed-loop cycle), then a
+                     table of medians and steps per second
                      (args go to criterion, e.g. `--measurement-time 3`)
   demo               run the report's demonstration (not yet: arrives with the closed-loop issue)
 ";
