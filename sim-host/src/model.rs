@@ -36,6 +36,15 @@ pub enum ModelError {
         /// The missing name.
         name: String,
     },
+    /// The leg drives cannot go torque-free one leg at a time: each leg's four actuators must
+    /// share an actuator group of their own (0…30), apart from the wheels'.
+    #[error("the model {path} needs each leg's actuators in a group of their own (hybrid_robot.xml uses FL 1, FR 2, BL 3, BR 4; wheels 0): {detail}")]
+    ActuatorGroups {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        detail: String,
+    },
     /// The model's timestep does not divide the control period.
     #[error("the model {path} has timestep {timestep_s} s, which does not divide the control period {period_s} s")]
     Timestep {
@@ -145,12 +154,38 @@ impl Layout {
             layout.foot_touch[leg] = sensor(&format!("touch_{suffix}"))?;
             layout.foot_geoms[leg] = geom(&format!("foot_{suffix}"))?;
         }
+        let groups = model.actuator_group();
+        for (i, name) in JOINT_NAMES.iter().enumerate() {
+            let group = groups[layout.leg_actuator[i]];
+            if group as u32 != layout.leg_group[i / 4] || !(0..=30).contains(&group) {
+                return Err(ModelError::ActuatorGroups {
+                    path: path.to_owned(),
+                    detail: format!("m_{name} is in group {group}"),
+                });
+            }
+        }
+        let mut distinct = layout.leg_group.to_vec();
+        distinct.sort_unstable();
+        distinct.dedup();
+        if distinct.len() != 4 {
+            return Err(ModelError::ActuatorGroups {
+                path: path.to_owned(),
+                detail: format!("leg groups {:?} are not distinct", layout.leg_group),
+            });
+        }
         for (i, side) in WHEEL_NAMES.iter().enumerate() {
             let j = joint(&format!("wheel_{side}_joint"))?;
             layout.wheel_qpos[i] = qpos(j);
             layout.wheel_qvel[i] = qvel(j);
             layout.wheel_actuator[i] = actuator(&format!("m_wheel_{side}"))?;
             layout.wheel_force_sensor[i] = sensor(&format!("frc_wheel_{side}"))?;
+            let group = groups[layout.wheel_actuator[i]] as u32;
+            if layout.leg_group.contains(&group) {
+                return Err(ModelError::ActuatorGroups {
+                    path: path.to_owned(),
+                    detail: format!("m_wheel_{side} shares group {group} with a leg"),
+                });
+            }
         }
         Ok(layout)
     }

@@ -1,0 +1,123 @@
+//! `sim-host run` as a user meets it: outputs in `--out`, and errors that say what to do.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn sim_host() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_sim-host"))
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("sim-host-cli-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn a_run_leaves_telemetry_a_candump_log_and_plots() {
+    let out = scratch("run");
+    let result = sim_host()
+        .args(["run", "--duration", "2", "--drive", "0:X", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&result.stdout);
+    assert!(
+        result.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&result.stderr)
+    );
+    assert!(
+        stdout.contains("cycles           500 (0 missed"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("0 by the drives, 0 by the firmware"),
+        "{stdout}"
+    );
+    let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 501, "a header and one row per cycle");
+    let log = std::fs::read_to_string(out.join("bus.log")).unwrap();
+    // Every cycle: SYNC, wheel feedback, IMU, four leg feedbacks from the simulator, leg targets
+    // and the wheel command from the firmware.
+    let syncs = log.lines().filter(|l| l.contains(" vcan0 010##")).count();
+    let commands = log.lines().filter(|l| l.contains(" vcan0 101##")).count();
+    assert_eq!((syncs, commands), (500, 500));
+    for png in [
+        "wheel_torque.png",
+        "front_left_joints.png",
+        "torso_trajectory.png",
+        "torso_height.png",
+    ] {
+        let bytes = std::fs::read(out.join(png)).unwrap();
+        assert!(bytes.starts_with(b"\x89PNG"), "{png}");
+    }
+}
+
+#[test]
+fn a_missing_can_interface_names_the_commands_that_create_it() {
+    let result = sim_host()
+        .args(["run", "--bus", "vcan-absent9", "--duration", "1", "--out"])
+        .arg(scratch("novcan"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert_eq!(result.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("sudo modprobe vcan && sudo ip link add vcan-absent9 type vcan"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn a_bad_drive_step_is_rejected_with_the_accepted_keys() {
+    let result = sim_host().args(["run", "--drive", "2:Q"]).output().unwrap();
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert_eq!(result.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("use W S A L K X, stand or fold"),
+        "{stderr}"
+    );
+}
+
+#[test]
+fn a_broken_model_names_the_file() {
+    let dir = scratch("model");
+    std::fs::create_dir_all(&dir).unwrap();
+    let model = dir.join("robot.xml");
+    std::fs::write(&model, "<mujoco><worldbody><body></mujoco>").unwrap();
+    let result = sim_host()
+        .args(["run", "--duration", "1", "--model"])
+        .arg(&model)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert_eq!(result.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("robot.xml"), "{stderr}");
+}
+
+#[test]
+fn real_time_mode_runs_on_the_wall_clock_and_reports_it() {
+    let started = std::time::Instant::now();
+    let result = sim_host()
+        .args([
+            "run",
+            "--mode",
+            "realtime",
+            "--duration",
+            "1",
+            "--no-plots",
+            "--out",
+        ])
+        .arg(scratch("realtime"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&result.stdout);
+    assert!(result.status.success(), "{stdout}");
+    assert!(stdout.contains("cycles           250 ("), "{stdout}");
+    assert!(stdout.contains("x real time"), "{stdout}");
+    // One simulated second takes at least one wall second (it may take longer on a busy machine).
+    assert!(started.elapsed() >= std::time::Duration::from_millis(990));
+}
