@@ -11,6 +11,7 @@
 pub mod bus;
 pub mod candump;
 pub mod drive_core;
+pub mod error_chain;
 pub mod hardware;
 pub mod imu;
 pub mod inproc_bus;
@@ -23,6 +24,8 @@ pub mod physics;
 pub mod plots;
 pub mod realtime;
 pub mod recorder;
+#[cfg(feature = "renderer")]
+pub mod render;
 pub mod run_stats;
 pub mod scripted_teleop;
 pub mod session;
@@ -30,4 +33,6 @@ pub mod simulator;
 pub mod socketcan_bus;
 pub mod telemetry;
 pub mod telemetry_csv;
+#[cfg(feature = "viewer")]
+pub mod viewer;
 pub mod wheel_drive;

@@ -1,6 +1,7 @@
 //! `sim-host`: the hybrid wheel–leg robot in MuJoCo, playing its leg drives, wheel drive and IMU
 //! on a CAN bus.
 
+use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -10,7 +11,7 @@ use protocol::TeleopMode;
 use sim_host::imu::ImuNoise;
 use sim_host::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
 use sim_host::scripted_teleop::PlanStep;
-use sim_host::session::{self, BusChoice, Clock, SessionConfig};
+use sim_host::session::{self, BusChoice, Clock, FrameSettings, SessionConfig};
 
 /// The hybrid wheel–leg robot in MuJoCo, on a CAN bus.
 ///
@@ -96,9 +97,16 @@ struct RunArgs {
     /// Skip the PNG plots.
     #[arg(long)]
     no_plots: bool,
-    /// Open the interactive MuJoCo viewer (build with `--features viewer`).
+    /// Open the interactive MuJoCo viewer, synced every control cycle; it stays open after the
+    /// run until closed, and closing it early ends the run. Needs a display; best with
+    /// `--mode realtime` (lockstep plays faster than real time). Build with `--features viewer`.
     #[arg(long)]
     viewer: bool,
+    /// Render the model's `chase` camera to <out>/frames/frame_00000.png, … at the start and
+    /// every N control cycles (25 at 250 Hz: 10 frames per simulated second). Headless, through
+    /// EGL (Mesa: libegl1 libegl-mesa0 libgl1-mesa-dri). Build with `--features renderer`.
+    #[arg(long, value_name = "N")]
+    render_every: Option<NonZeroU32>,
 }
 
 fn parse_step(text: &str) -> Result<PlanStep, String> {
@@ -157,6 +165,12 @@ fn run(args: RunArgs) -> Result<(), String> {
                 .into(),
         );
     }
+    if args.render_every.is_some() && !cfg!(feature = "renderer") {
+        return Err(
+            "this sim-host was built without the renderer: cargo run -p sim-host --features renderer -- run --render-every 25 …"
+                .into(),
+        );
+    }
     if !(args.duration.is_finite() && args.duration > 0.0) {
         return Err(format!(
             "--duration {} must be a positive number of seconds",
@@ -194,6 +208,11 @@ fn run(args: RunArgs) -> Result<(), String> {
         out_dir: Some(args.out.clone()),
         plots: !args.no_plots,
         progress: true,
+        frames: args.render_every.map(|every_cycles| FrameSettings {
+            dir: args.out.join("frames"),
+            every_cycles,
+        }),
+        viewer: args.viewer,
     };
     tracing::info!(model = %config.model.display(), bus = %args.bus, "starting");
     let report = session::run(&config).map_err(|e| e.to_string())?;
@@ -230,6 +249,13 @@ fn run(args: RunArgs) -> Result<(), String> {
             row.torso_rpy_deg[0],
             row.torso_rpy_deg[1],
             row.torso_rpy_deg[2]
+        );
+    }
+    if let Some(first) = report.frames.first() {
+        println!(
+            "rendered         {} frames from {}",
+            report.frames.len(),
+            first.display()
         );
     }
     for file in &report.files {

@@ -78,6 +78,11 @@ impl Physics {
         self.data.model()
     }
 
+    /// The MuJoCo state (read-only: for renderers and viewers, which copy what they draw).
+    pub fn data(&self) -> &MjData<Box<MjModel>> {
+        &self.data
+    }
+
     /// Indices of the robot's parts.
     pub fn layout(&self) -> &Layout {
         &self.layout

@@ -2,6 +2,7 @@
 //! (with the firmware in-process on the in-process bus), run it in lockstep or real time, and
 //! leave the telemetry CSV, the candump log and the plots in an output folder.
 
+use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -40,6 +41,15 @@ pub enum Clock {
     Realtime,
 }
 
+/// Frames to render during a run (feature `renderer`): the model's `chase` camera, offscreen.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FrameSettings {
+    /// Folder for `frame_00000.png`, `frame_00001.png`, …; created if missing.
+    pub dir: PathBuf,
+    /// One frame at the start and one every this many control cycles.
+    pub every_cycles: NonZeroU32,
+}
+
 /// Everything a run needs.
 #[derive(Debug, Clone)]
 pub struct SessionConfig {
@@ -65,6 +75,11 @@ pub struct SessionConfig {
     pub plots: bool,
     /// Show a progress bar.
     pub progress: bool,
+    /// Frames to render (`None`: none). Without the `renderer` feature, `Some` is an error.
+    pub frames: Option<FrameSettings>,
+    /// Open the MuJoCo viewer, synced every cycle, and keep it open after the run until it is
+    /// closed (closing it early ends the run). Without the `viewer` feature, `true` is an error.
+    pub viewer: bool,
 }
 
 /// Why a session failed.
@@ -89,6 +104,22 @@ pub enum SessionError {
     /// The firmware's configuration was rejected.
     #[error("the firmware rejected its configuration: {0:?}")]
     Firmware(firmware::controller::ConfigError),
+    /// Rendering frames.
+    #[cfg(feature = "renderer")]
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+    /// The viewer.
+    #[cfg(feature = "viewer")]
+    #[error(transparent)]
+    Viewer(#[from] crate::viewer::ViewerError),
+    /// The configuration asks for a feature this build leaves out.
+    #[error("{what} needs sim-host built with `--features {feature}` (cargo run -p sim-host --features {feature} -- run …)")]
+    NotBuilt {
+        /// What was asked for.
+        what: &'static str,
+        /// The cargo feature it needs.
+        feature: &'static str,
+    },
 }
 
 /// What a session leaves behind.
@@ -104,6 +135,8 @@ pub struct SessionReport {
     pub firmware_rejected: Option<u64>,
     /// Frames the emulated drives rejected.
     pub drives_rejected: u64,
+    /// Rendered frames, in order (empty without [`SessionConfig::frames`]).
+    pub frames: Vec<PathBuf>,
 }
 
 /// Runs one session.
@@ -134,12 +167,17 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         }
         None => Recorder::in_memory(),
     };
+    let mut watch = Watch::open(config, &sim)?;
+    let mut watch_error = None;
     let progress = progress_bar(config.progress, cycles);
     let mut observe = |s: &Simulator| {
         if u64::from(s.cycle()) % 25 == 0 {
             progress.set_position(u64::from(s.cycle()));
         }
-        true
+        watch.cycle(s).unwrap_or_else(|e| {
+            watch_error = Some(e);
+            false
+        })
     };
     let mut teleop = ScriptedTeleop::new(config.teleop_plan.clone());
     let has_teleop = !config.teleop_plan.is_empty();
@@ -202,6 +240,10 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         }
     };
     progress.finish_and_clear();
+    if let Some(e) = watch_error {
+        return Err(e);
+    }
+    let frames = watch.finish()?;
     let drives_rejected = sim.hardware().rejected();
     let rows = recorder.finish()?;
     if let Some(dir) = &config.out_dir {
@@ -218,7 +260,88 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         files,
         firmware_rejected,
         drives_rejected,
+        frames,
     })
+}
+
+/// What watches a run besides the progress bar: frames (feature `renderer`) and the viewer
+/// (feature `viewer`).
+#[derive(Debug, Default)]
+struct Watch {
+    #[cfg(feature = "renderer")]
+    frames: Option<crate::render::FrameRenderer>,
+    #[cfg(feature = "viewer")]
+    viewer: Option<crate::viewer::Viewer>,
+}
+
+impl Watch {
+    /// Opens what `config` asks for and renders the starting frame.
+    fn open(config: &SessionConfig, sim: &Simulator) -> Result<Self, SessionError> {
+        #[allow(unused_mut)]
+        let mut watch = Self::default();
+        if let Some(frames) = &config.frames {
+            #[cfg(feature = "renderer")]
+            {
+                let options = crate::render::FrameOptions::chase(&frames.dir, frames.every_cycles);
+                let mut renderer =
+                    crate::render::FrameRenderer::new(sim.physics().model(), options)?;
+                renderer.render(sim.physics())?;
+                watch.frames = Some(renderer);
+            }
+            #[cfg(not(feature = "renderer"))]
+            {
+                let _ = frames;
+                return Err(SessionError::NotBuilt {
+                    what: "rendering frames",
+                    feature: "renderer",
+                });
+            }
+        }
+        if config.viewer {
+            #[cfg(feature = "viewer")]
+            {
+                watch.viewer = Some(crate::viewer::Viewer::open(sim.physics().model())?);
+            }
+            #[cfg(not(feature = "viewer"))]
+            return Err(SessionError::NotBuilt {
+                what: "the viewer",
+                feature: "viewer",
+            });
+        }
+        let _ = sim;
+        Ok(watch)
+    }
+
+    /// After a cycle: renders a frame if one is due, syncs the viewer. `false`: the viewer was
+    /// closed, end the run.
+    fn cycle(&mut self, sim: &Simulator) -> Result<bool, SessionError> {
+        #[cfg(feature = "renderer")]
+        if let Some(frames) = &mut self.frames {
+            frames.observe(sim)?;
+        }
+        #[cfg(feature = "viewer")]
+        if let Some(viewer) = &mut self.viewer {
+            return Ok(viewer.observe(sim)?);
+        }
+        let _ = sim;
+        Ok(true)
+    }
+
+    /// After the run: keeps the viewer open until it is closed; returns the frames written.
+    fn finish(self) -> Result<Vec<PathBuf>, SessionError> {
+        #[cfg(feature = "viewer")]
+        if let Some(mut viewer) = self.viewer {
+            if viewer.running() {
+                tracing::info!("run finished: close the viewer window to exit");
+            }
+            viewer.hold()?;
+        }
+        #[cfg(feature = "renderer")]
+        if let Some(frames) = self.frames {
+            return Ok(frames.into_frames());
+        }
+        Ok(Vec::new())
+    }
 }
 
 fn drive(

@@ -1,5 +1,6 @@
 //! `cargo xtask <task>`: every project task. This file only dispatches; each task is a module.
 
+mod apt;
 mod bench;
 mod busload;
 mod dbc;
@@ -16,10 +17,11 @@ cargo xtask <task> [options]
 
 Tasks:
   setup              install what the project needs (rustup target, Python venv with cantools,
-                     the MuJoCo library in .cache/mujoco);
-                     idempotent, fast when already done
-  test               everything CI checks: fmt, clippy -D warnings, DBC freshness, no f64 in the
-                     no_std crates, all tests, and a thumbv7em-none-eabihf build of the no_std crates
+                     the MuJoCo library in .cache/mujoco, Mesa EGL from apt); idempotent, fast
+                     when already done
+  test               everything CI checks: fmt, clippy -D warnings (all features), DBC
+                     freshness, no f64 in the no_std crates, all tests (the headless renderer's
+                     too), and a thumbv7em-none-eabihf build of the no_std crates
   dbc [--check]      regenerate protocol/hybrid_robot.dbc (--check: fail if the committed file is stale)
   busload            print the per-cycle frame schedule and the bus load at 250 Hz and 1 kHz
   bench [args]       criterion benchmarks (control step, raw MuJoCo step, closed-loop cycle), then a

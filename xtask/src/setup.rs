@@ -3,7 +3,8 @@
 //! - the `thumbv7em-none-eabihf` rustup target (the MCU build);
 //! - a project-local Python venv (`.venv/`) with the pinned `cantools`, used by the tests that
 //!   read the bus with standard tools, and pip's `download` for MuJoCo;
-//! - the MuJoCo library in `.cache/mujoco/` ([`crate::mujoco`]).
+//! - the MuJoCo library in `.cache/mujoco/` ([`crate::mujoco`]);
+//! - Mesa's EGL for headless rendering, from apt ([`crate::apt`]).
 //!
 //! Nothing is installed system-wide.
 
@@ -24,6 +25,10 @@ pub fn run() -> Result<(), String> {
     ensure_target()?;
     ensure_venv()?;
     crate::mujoco::ensure()?;
+    crate::apt::ensure(
+        &crate::apt::RENDERING,
+        "headless rendering (sim-host --features renderer)",
+    )?;
     eprintln!("setup: done");
     Ok(())
 }

@@ -16,6 +16,7 @@ pub fn run() -> Result<(), String> {
         "clippy",
         "--workspace",
         "--all-targets",
+        "--all-features",
         "--",
         "-D",
         "warnings",
@@ -25,6 +26,16 @@ pub fn run() -> Result<(), String> {
     sh(cargo()
         .args(["test", "--workspace"])
         .env("PROTOCOL_PYTHON", venv_python()))?;
+    // Headless rendering through Mesa EGL (the feature is off by default).
+    sh(cargo().args([
+        "test",
+        "-p",
+        "sim-host",
+        "--features",
+        "renderer",
+        "--test",
+        "render",
+    ]))?;
     let mut build = cargo();
     build.args(["build", "--target", MCU_TARGET]);
     for krate in NO_STD_CRATES {
