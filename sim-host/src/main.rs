@@ -4,6 +4,8 @@
 use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -158,6 +160,17 @@ fn main() -> ExitCode {
     }
 }
 
+/// A flag that Ctrl-C sets, so that an interrupted run still writes its outputs. If the handler
+/// cannot be installed, Ctrl-C keeps its default effect (the process ends) and the run says so.
+fn stop_on_ctrl_c() -> Arc<AtomicBool> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        tracing::warn!("Ctrl-C will end the run without writing its outputs: {e}");
+    }
+    stop
+}
+
 fn run(args: RunArgs) -> Result<(), String> {
     if args.viewer && !cfg!(feature = "viewer") {
         return Err(
@@ -213,10 +226,14 @@ fn run(args: RunArgs) -> Result<(), String> {
             every_cycles,
         }),
         viewer: args.viewer,
+        stop: Some(stop_on_ctrl_c()),
     };
     tracing::info!(model = %config.model.display(), bus = %args.bus, "starting");
     let report = session::run(&config).map_err(|e| e.to_string())?;
     let s = report.stats;
+    if report.interrupted {
+        println!("interrupted      (Ctrl-C) — outputs cover the simulated part");
+    }
     let last = report.rows.last();
     println!(
         "simulated        {:.2} s in {:.2} s wall ({:.1}x real time)",

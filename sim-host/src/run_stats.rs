@@ -59,9 +59,6 @@ pub enum RunError {
         /// When, s.
         time_s: f64,
     },
-    /// The user interrupted the run (Ctrl-C).
-    #[error("interrupted")]
-    Interrupted,
 }
 
 impl From<protocol::EncodeError> for RunError {

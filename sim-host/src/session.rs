@@ -4,6 +4,8 @@
 
 use std::num::NonZeroU32;
 use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -75,6 +77,8 @@ pub struct SessionConfig {
     pub plots: bool,
     /// Show a progress bar.
     pub progress: bool,
+    /// Set (by a Ctrl-C handler, say) to end the run early; the outputs are still written.
+    pub stop: Option<Arc<AtomicBool>>,
     /// Frames to render (`None`: none). Without the `renderer` feature, `Some` is an error.
     pub frames: Option<FrameSettings>,
     /// Open the MuJoCo viewer, synced every cycle, and keep it open after the run until it is
@@ -137,6 +141,8 @@ pub struct SessionReport {
     pub drives_rejected: u64,
     /// Rendered frames, in order (empty without [`SessionConfig::frames`]).
     pub frames: Vec<PathBuf>,
+    /// Whether [`SessionConfig::stop`] ended the run early.
+    pub interrupted: bool,
 }
 
 /// Runs one session.
@@ -170,9 +176,18 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
     let mut watch = Watch::open(config, &sim)?;
     let mut watch_error = None;
     let progress = progress_bar(config.progress, cycles);
+    let mut interrupted = false;
     let mut observe = |s: &Simulator| {
         if u64::from(s.cycle()) % 25 == 0 {
             progress.set_position(u64::from(s.cycle()));
+        }
+        if config
+            .stop
+            .as_ref()
+            .is_some_and(|stop| stop.load(Ordering::Relaxed))
+        {
+            interrupted = true;
+            return false;
         }
         watch.cycle(s).unwrap_or_else(|e| {
             watch_error = Some(e);
@@ -261,6 +276,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         firmware_rejected,
         drives_rejected,
         frames,
+        interrupted,
     })
 }
 
