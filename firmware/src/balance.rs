@@ -103,9 +103,13 @@ pub struct BalanceConfig {
     /// Pitch at which the body's centre of mass is over the axle, rad (a fold pose that puts
     /// mass behind the hips needs a forward lean).
     pub pitch_trim_rad: f32,
-    /// The speed reference follows a request at most this fast, m/s²: a step in speed would
-    /// throw the pendulum over by the lean it needs to accelerate.
+    /// The speed reference speeds up at most this fast, m/s²: a step in speed would throw the
+    /// pendulum over by the lean it needs to accelerate (about 0.2 rad per m/s² on this robot,
+    /// plus the law's overshoot).
     pub accel_limit_m_s2: f32,
+    /// The speed reference slows down at most this fast, m/s²: higher than the acceleration
+    /// limit, so that a stop is quick; the lean it costs is brief.
+    pub brake_limit_m_s2: f32,
 }
 
 /// What the balance law reads each tick.
@@ -163,9 +167,17 @@ impl Balance {
     /// One tick of `dt_s`: the total wheel torque, N·m, within ±`torque_limit_nm`. Any
     /// non-finite input gives zero torque and leaves the state untouched.
     pub fn update(&mut self, input: &BalanceInput, dt_s: f32) -> f32 {
-        let step = self.config.accel_limit_m_s2 * dt_s;
-        let velocity_ref = self.velocity_ref_m_s
-            + crate::math::clamp(input.velocity_ref_m_s - self.velocity_ref_m_s, -step, step);
+        let current = self.velocity_ref_m_s;
+        let change = input.velocity_ref_m_s - current;
+        // Slowing down: the change points back toward zero speed.
+        let braking = change * current < 0.0;
+        let limit_m_s2 = if braking {
+            self.config.brake_limit_m_s2
+        } else {
+            self.config.accel_limit_m_s2
+        };
+        let step = limit_m_s2 * dt_s;
+        let velocity_ref = current + crate::math::clamp(change, -step, step);
         let speed_error = self.ground_speed_m_s(input) - velocity_ref;
         let pitch = input.pitch_rad - self.config.pitch_trim_rad;
         if !(speed_error.is_finite()

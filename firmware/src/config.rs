@@ -6,6 +6,7 @@ use crate::kinematics::LegGeometry;
 use crate::limits::JointLimits;
 use crate::posture::Posture;
 use crate::smoothing::Smoother;
+use crate::support::SupportGeometry;
 use crate::time::TickRate;
 use crate::wheel::SpeedLoopGains;
 
@@ -20,6 +21,8 @@ pub struct Config {
     pub limits: JointLimits,
     /// Fold and stance poses.
     pub posture: Posture,
+    /// What touches the ground: when the wheels may be driven.
+    pub support: SupportGeometry,
     /// Trot.
     pub trot: TrotParams,
     /// Leg smoothing rate, 1/s (the report's 8).
@@ -56,6 +59,7 @@ impl Config {
         geometry: LegGeometry::ROBOT,
         limits: JointLimits::REPORT,
         posture: Posture::ROBOT,
+        support: SupportGeometry::ROBOT,
         trot: TrotParams::DEFAULT,
         leg_rate_per_s: Smoother::LEG_RATE_PER_S,
         fold_rate_per_s: Smoother::FOLD_RATE_PER_S,
@@ -68,8 +72,9 @@ impl Config {
             wheel_radius_m: BalanceModel::ROBOT.wheel_radius_m,
             torque_limit_nm: 2.0 * WHEEL_TORQUE_LIMIT_NM,
             position_error_limit_m: 0.3,
-            pitch_trim_rad: 0.0,
-            accel_limit_m_s2: 1.5,
+            pitch_trim_rad: crate::math::deg_to_rad(3.2),
+            accel_limit_m_s2: 0.25,
+            brake_limit_m_s2: 0.6,
         },
         feedback_timeout_ms: 50,
         imu_timeout_ms: 50,

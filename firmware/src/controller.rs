@@ -203,7 +203,7 @@ impl Controller {
                 self.smooth(self.config.fold_rate_per_s);
             }
         }
-        if self.state.balancing() && self.armed {
+        if self.state.balancing() && self.armed && self.wheels_may_drive() {
             wheel_torque_nm = self.wheel_law(now, dt_s);
         } else {
             self.balance.reset();
@@ -290,6 +290,16 @@ impl Controller {
         {
             self.apply(Event::Fault);
         }
+    }
+
+    /// On the wheels the balance law always runs; while folding or standing up only once the
+    /// measured leg pose puts the wheels on the ground (see [`crate::support`]).
+    fn wheels_may_drive(&self) -> bool {
+        matches!(self.state, State::Wheels(_))
+            || self
+                .config
+                .support
+                .wheels_grounded(&self.config.geometry, &self.sensors.joint_position_rad)
     }
 
     /// Whether a running transition has brought every target to its pose (checked after
@@ -397,17 +407,13 @@ impl Controller {
 
 /// The fold pose for all four legs, clamped into the joint ranges.
 fn fold_goal(config: &Config) -> [f32; 16] {
-    let mut goal = repeat(config.posture.fold);
+    let front = config.posture.fold_front.to_array();
+    let back = config.posture.fold_back.to_array();
+    let mut goal = [0.0; 16];
+    for (leg, chunk) in goal.chunks_exact_mut(4).enumerate() {
+        chunk.copy_from_slice(if leg < 2 { &front } else { &back });
+    }
     let fallback = goal;
     clamp_leg_targets(&config.limits, &mut goal, &fallback);
     goal
-}
-
-fn repeat(joints: LegJoints) -> [f32; 16] {
-    let one = joints.to_array();
-    let mut all = [0.0; 16];
-    for chunk in all.chunks_exact_mut(4) {
-        chunk.copy_from_slice(&one);
-    }
-    all
 }

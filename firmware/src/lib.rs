@@ -44,6 +44,7 @@ pub mod safety;
 pub mod sensors;
 pub mod sine_gait;
 pub mod smoothing;
+pub mod support;
 pub mod teleop;
 pub mod time;
 pub mod wheel;

@@ -184,9 +184,17 @@ fn w_folds_the_legs_at_the_fold_rate_then_drives_on_the_wheels() {
         bench.state(),
         State::Wheels(WheelMotion::Drive(firmware::fsm::Direction::Forward))
     );
-    // Hip pitch of the fold pose (−1.0 rad) is clamped to the report's −50° limit.
-    let hip = bench.joints_rad[1];
-    assert!((hip - (-50f32).to_radians()).abs() < 0.011, "hip {hip}");
+    // The fold: front hips at +50°, back hips at −45° (see `Posture::ROBOT`).
+    let front_hip = bench.joints_rad[1];
+    let back_hip = bench.joints_rad[9];
+    assert!(
+        (front_hip - 50f32.to_radians()).abs() < 0.011,
+        "front hip {front_hip}"
+    );
+    assert!(
+        (back_hip - (-45f32).to_radians()).abs() < 0.011,
+        "back hip {back_hip}"
+    );
 }
 
 #[test]

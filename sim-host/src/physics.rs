@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use mujoco_rs::prelude::{MjData, MjModel};
+use mujoco_rs::wrappers::mj_model::MjtObjBase as MjtObj;
 
 use crate::model::{load, Layout, ModelError};
 
@@ -227,6 +228,30 @@ impl Physics {
             quat_wxyz: [q[3], q[4], q[5], q[6]],
             vel_m_s: [v[0], v[1], v[2]],
         }
+    }
+
+    /// Names of the robot's geoms touching anything that is not the robot (diagnostics).
+    pub fn ground_contact_names(&self) -> Vec<String> {
+        let model = self.data.model();
+        let mut names = Vec::new();
+        for contact in self.data.contact() {
+            for geom in [contact.geom1, contact.geom2] {
+                let Ok(id) = usize::try_from(geom) else {
+                    continue;
+                };
+                let body = model.geom_bodyid().get(id).copied().unwrap_or(0);
+                if body != 0 {
+                    let name = model
+                        .id_to_name(MjtObj::mjOBJ_GEOM, id)
+                        .unwrap_or("(unnamed)")
+                        .to_owned();
+                    if !names.contains(&name) {
+                        names.push(name);
+                    }
+                }
+            }
+        }
+        names
     }
 
     /// Which parts of the robot touch anything that is not the robot.

@@ -378,6 +378,8 @@ mod tests {
                     leg_joint_rad,
                     wheel_torque_nm: [(t * 5.0).sin(), (t * 5.0).cos()],
                     wheel_speed_rad_s: [t, -t],
+                    foot_force_n: [0.0; 4],
+                    body_contact: false,
                     mode,
                 }
             })

@@ -155,6 +155,8 @@ impl Simulator {
             leg_joint_rad: self.physics.leg_positions_rad(),
             wheel_torque_nm: self.hardware.wheel_torque_nm(self.now_us),
             wheel_speed_rad_s: self.physics.wheel_velocities_rad_s(),
+            foot_force_n: self.physics.foot_forces_n(),
+            body_contact: self.physics.ground_contacts().other,
             mode: self.hardware.controller_mode(),
         }
     }

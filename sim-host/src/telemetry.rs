@@ -18,6 +18,11 @@ pub struct TelemetryRow {
     pub wheel_torque_nm: [f64; 2],
     /// Wheel speeds, left and right, rad/s (+ = rolling forward).
     pub wheel_speed_rad_s: [f64; 2],
+    /// Normal force on each foot (FL, FR, BL, BR) from its touch sensor, N (0 in the air).
+    pub foot_force_n: [f64; 4],
+    /// Whether a part of the robot other than its wheels and feet (torso, a leg link) touches
+    /// the ground.
+    pub body_contact: bool,
     /// The controller's mode from its last status frame, `None` before the first.
     pub mode: Option<ControllerMode>,
 }

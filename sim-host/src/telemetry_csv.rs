@@ -10,7 +10,7 @@ use crate::output_error::OutputError;
 use crate::telemetry::TelemetryRow;
 
 /// The CSV's column names, in order: time, torso position and attitude, one `<joint>_rad`
-/// column per leg joint in [`JOINT_NAMES`] order, wheel torques and speeds, controller mode.
+/// column per leg joint in [`JOINT_NAMES`] order, wheel torques and speeds, foot forces, body contact, controller mode.
 pub fn header() -> Vec<String> {
     let leading = [
         "time_s",
@@ -26,6 +26,11 @@ pub fn header() -> Vec<String> {
         "wheel_right_torque_nm",
         "wheel_left_speed_rad_s",
         "wheel_right_speed_rad_s",
+        "foot_fl_force_n",
+        "foot_fr_force_n",
+        "foot_bl_force_n",
+        "foot_br_force_n",
+        "body_contact",
         "mode",
     ];
     let joints = JOINT_NAMES.iter().map(|joint| format!("{joint}_rad"));
@@ -60,8 +65,10 @@ pub fn write_csv(path: &Path, rows: &[TelemetryRow]) -> Result<(), OutputError> 
             .chain(&row.torso_rpy_deg)
             .chain(&row.leg_joint_rad)
             .chain(&row.wheel_torque_nm)
-            .chain(&row.wheel_speed_rad_s);
+            .chain(&row.wheel_speed_rad_s)
+            .chain(&row.foot_force_n);
         record.extend(numbers.map(f64::to_string));
+        record.push(u8::from(row.body_contact).to_string());
         record.push(row.mode.map_or("", |mode| mode.label()).to_owned());
         writer.write_record(&record).map_err(csv_error)?;
     }
@@ -95,6 +102,8 @@ mod tests {
             leg_joint_rad,
             wheel_torque_nm: [0.75, -0.125],
             wheel_speed_rad_s: [10.0, 11.0],
+            foot_force_n: [0.0; 4],
+            body_contact: false,
             mode,
         }
     }
@@ -102,13 +111,13 @@ mod tests {
     #[test]
     fn header_names_every_column_in_order() {
         let header = header();
-        assert_eq!(header.len(), 7 + 16 + 5);
+        assert_eq!(header.len(), 7 + 16 + 10);
         assert_eq!(header[0], "time_s");
         assert_eq!(header[6], "yaw_deg");
         assert_eq!(header[7], "hip1_fl_rad");
         assert_eq!(header[22], "ankle_br_rad");
         assert_eq!(header[23], "wheel_left_torque_nm");
-        assert_eq!(header[27], "mode");
+        assert_eq!(header[32], "mode");
     }
 
     #[test]
@@ -126,9 +135,9 @@ mod tests {
         let lines: Vec<&str> = text.lines().collect();
         assert_eq!(lines.len(), rows.len() + 1);
         assert_eq!(lines[0], header().join(","));
-        assert_eq!(lines[0].split(',').count(), 28);
+        assert_eq!(lines[0].split(',').count(), 33);
         assert!(lines[1].starts_with("0,1.5,-0.25,0.3,0.5,-2,90,0,0.01,"));
-        assert!(lines[1].ends_with(",0.75,-0.125,10,11,"));
+        assert!(lines[1].ends_with(",0.75,-0.125,10,11,0,0,0,0,0,"));
         assert!(lines[2].starts_with("0.004,"));
         assert!(lines[2].ends_with(",WheelForward"));
         assert!(lines[3].ends_with(",Stop"));

@@ -67,13 +67,13 @@ fn dropped_with_legs_extended_it_settles_standing_within_2_s() {
 #[test]
 fn folded_on_free_wheels_it_tips_over() {
     let mut p = physics();
-    let config = firmware::config::Config::ROBOT;
-    let raw = config.posture.fold.to_array();
-    let joints: [f64; 4] =
-        std::array::from_fn(|j| f64::from(config.limits.ranges[j].clamp(raw[j], 0.0)));
+    let posture = firmware::config::Config::ROBOT.posture;
+    let front = posture.fold_front.to_array();
+    let back = posture.fold_back.to_array();
     let mut legs = [0.0; 16];
     for (i, angle) in legs.iter_mut().enumerate() {
-        *angle = joints[i % 4];
+        let pose = if i < 8 { &front } else { &back };
+        *angle = f64::from(pose[i % 4]);
     }
     // Wheels (r 0.12 at z −0.15) just on the ground, torso level, wheels unpowered.
     p.place(0.12 + 0.15 + 0.001, &legs);

@@ -1,0 +1,59 @@
+//! What carries the robot: its legs or its wheels. The balance law may only drive the wheels
+//! while they are on the ground; a wheel torque with the wheels in the air spins them up, and
+//! the stored momentum jolts the robot when they touch down.
+//!
+//! On flat ground the torso stands on its legs at the depth of its deepest foot (below the
+//! hips, from the measured joint angles) plus the foot radius; the wheels touch once that
+//! height falls to the wheels' contact height (mount depth + wheel radius).
+
+use crate::kinematics::{leg_fk, LegGeometry, LegJoints};
+
+/// Dimensions that decide which part touches the ground.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SupportGeometry {
+    /// Foot sphere radius, m.
+    pub foot_radius_m: f32,
+    /// Torso-centre height at which the wheels touch flat ground (wheel mount depth below the
+    /// hips' plane + wheel radius), m.
+    pub wheel_contact_height_m: f32,
+    /// The wheels count as on the ground up to this far above it, m: joint sag and servo error.
+    pub margin_m: f32,
+}
+
+impl SupportGeometry {
+    /// The robot: foot r 0.035 m, wheels r 0.12 m mounted 0.15 m below the hips.
+    pub const ROBOT: Self = Self {
+        foot_radius_m: 0.035,
+        wheel_contact_height_m: 0.27,
+        margin_m: 0.01,
+    };
+
+    /// The torso-centre height the legs give on flat ground, m: the deepest foot + its radius.
+    /// Non-finite joint angles give 0 (the wheels are assumed to carry the robot).
+    pub fn leg_height_m(&self, geometry: &LegGeometry, joints_rad: &[f32; 16]) -> f32 {
+        let mut deepest_m: f32 = 0.0;
+        for leg in joints_rad.chunks_exact(4) {
+            if let &[hip_abduction_rad, hip_pitch_rad, knee_rad, ankle_rad] = leg {
+                let foot = leg_fk(
+                    geometry,
+                    &LegJoints {
+                        hip_abduction_rad,
+                        hip_pitch_rad,
+                        knee_rad,
+                        ankle_rad,
+                    },
+                );
+                if foot.z_m.is_finite() {
+                    deepest_m = deepest_m.max(-foot.z_m);
+                }
+            }
+        }
+        deepest_m + self.foot_radius_m
+    }
+
+    /// Whether the wheels are on the ground (the legs hold the torso no higher than the wheels'
+    /// contact height + margin).
+    pub fn wheels_grounded(&self, geometry: &LegGeometry, joints_rad: &[f32; 16]) -> bool {
+        self.leg_height_m(geometry, joints_rad) <= self.wheel_contact_height_m + self.margin_m
+    }
+}
