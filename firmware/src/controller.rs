@@ -196,7 +196,11 @@ impl Controller {
             State::Hold | State::Fault => {}
             State::Legs(motion) | State::Standing(motion) => {
                 self.leg_goal(motion, depth_m);
-                self.smooth(self.config.leg_rate_per_s);
+                let rate = match self.state {
+                    State::Legs(LegMotion::Trot(_)) => self.config.gait_rate_per_s,
+                    _ => self.config.leg_rate_per_s,
+                };
+                self.smooth(rate);
             }
             State::Folding(_) | State::Wheels(_) => {
                 self.goal_rad = self.fold_rad;

@@ -16,9 +16,10 @@
 //! The leg has three sagittal joints for a 2-D foot position, so the foot pitch φ is a free
 //! choice. It is scheduled linearly in the foot position, fitted to the middle of the window
 //! of φ in which all joints stay in range over the gait's workspace:
-//! `φ = φ0 + dφ/dx · x + dφ/dd · (depth − d_ref)`. The fit (φ0 = −121°, 120°/m, 500°/m about
-//! 0.33 m) keeps every joint 0.5° inside its range for a stance 0.30…0.37 m deep and for the
-//! default trot (8 cm stride, 4 cm clearance) on a stance line 0.345…0.37 m deep; the test
+//! `φ = φ0 + dφ/dx · x + dφ/dd · (depth − d_ref)`. The fit (φ0 = −119°, 80°/m, 600°/m about
+//! 0.33 m, found by a grid search) keeps every joint 1.9° inside its range for a stance
+//! 0.30…0.37 m deep and for the default trot (8 cm stride centred 3 cm ahead of the hip, 4 cm
+//! clearance) on a stance line 0.35…0.37 m deep; the test
 //! `every_gait_pose_solves_across_the_body_height_band_and_speed_scales` holds it to that.
 
 use crate::kinematics::{leg_ik, FootTarget, IkError, KneeBranch, LegGeometry, LegJoints};
@@ -93,10 +94,10 @@ impl Posture {
         depth_nominal_m: 0.35,
         depth_min_m: 0.30,
         depth_max_m: 0.37,
-        trot_depth_min_m: 0.345,
-        pitch_base_rad: deg_to_rad(-121.0),
-        pitch_per_x_rad_m: deg_to_rad(120.0),
-        pitch_per_depth_rad_m: deg_to_rad(500.0),
+        trot_depth_min_m: 0.35,
+        pitch_base_rad: deg_to_rad(-119.0),
+        pitch_per_x_rad_m: deg_to_rad(80.0),
+        pitch_per_depth_rad_m: deg_to_rad(600.0),
         pitch_reference_depth_m: 0.33,
         branch: KneeBranch::Down,
     };
