@@ -73,7 +73,7 @@ fn closed_loop(c: &mut Criterion) {
                     controller.service(cycle)?;
                     Ok(())
                 },
-                |_| true,
+                |_, _| true,
             )
             .expect("cycle")
         })

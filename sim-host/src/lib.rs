@@ -18,6 +18,7 @@ pub mod inproc_bus;
 pub mod inproc_controller;
 pub mod leg_drive;
 pub mod lockstep;
+pub mod metrics;
 pub mod model;
 pub mod output_error;
 pub mod physics;
@@ -27,10 +28,12 @@ pub mod recorder;
 #[cfg(feature = "renderer")]
 pub mod render;
 pub mod run_stats;
+pub mod scenario;
 pub mod scripted_teleop;
 pub mod session;
 pub mod simulator;
 pub mod socketcan_bus;
+pub mod summary;
 pub mod telemetry;
 pub mod telemetry_csv;
 #[cfg(feature = "viewer")]

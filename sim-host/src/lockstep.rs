@@ -33,7 +33,7 @@ pub fn run(
     recorder: &mut Recorder,
     options: LockstepOptions,
     mut peers: impl FnMut(u32) -> Result<(), RunError>,
-    mut observe: impl FnMut(&Simulator) -> bool,
+    mut observe: impl FnMut(&Simulator, &RunStats) -> bool,
 ) -> Result<RunStats, RunError> {
     let started = Instant::now();
     let mut stats = RunStats::default();
@@ -76,7 +76,7 @@ pub fn run(
             });
         }
         recorder.row(sim.telemetry());
-        if !observe(sim) {
+        if !observe(sim, &stats) {
             break;
         }
     }

@@ -12,8 +12,10 @@ use clap::{Parser, Subcommand, ValueEnum};
 use protocol::TeleopMode;
 use sim_host::imu::ImuNoise;
 use sim_host::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
+use sim_host::scenario::{mode_name, Scenario};
 use sim_host::scripted_teleop::PlanStep;
-use sim_host::session::{self, BusChoice, Clock, FrameSettings, SessionConfig};
+use sim_host::session::{self, BusChoice, Clock, FrameSettings, SegmentSpec, SessionConfig};
+use sim_host::summary::{self, Summary};
 
 /// The hybrid wheel–leg robot in MuJoCo, on a CAN bus.
 ///
@@ -61,9 +63,13 @@ struct RunArgs {
     /// Clock.
     #[arg(long, value_enum, default_value = "lockstep")]
     mode: Mode,
-    /// Simulated seconds to run.
-    #[arg(long, default_value_t = 10.0)]
-    duration: f64,
+    /// Simulated seconds to run (default 10, or the scenario's `duration_s`).
+    #[arg(long)]
+    duration: Option<f64>,
+    /// A scenario file (`scenarios/*.toml`: times and commands); writes `summary.json` with
+    /// figures per segment and prints them as a table. Replaces `--drive`.
+    #[arg(long, conflicts_with = "drive")]
+    scenario: Option<PathBuf>,
     /// Folder for telemetry.csv, bus.log (candump format) and the PNG plots.
     #[arg(long, default_value = "out/sim")]
     out: PathBuf,
@@ -184,12 +190,33 @@ fn run(args: RunArgs) -> Result<(), String> {
                 .into(),
         );
     }
-    if !(args.duration.is_finite() && args.duration > 0.0) {
+    let scenario = match &args.scenario {
+        Some(path) => Some(Scenario::load(path).map_err(|e| e.to_string())?),
+        None => None,
+    };
+    let duration = args
+        .duration
+        .or(scenario.as_ref().map(|s| s.duration_s))
+        .unwrap_or(10.0);
+    if !(duration.is_finite() && duration > 0.0) {
         return Err(format!(
-            "--duration {} must be a positive number of seconds",
-            args.duration
+            "--duration {duration} must be a positive number of seconds"
         ));
     }
+    let (teleop_plan, segments) = match &scenario {
+        Some(s) => (
+            s.plan(),
+            s.steps
+                .iter()
+                .map(|step| SegmentSpec {
+                    start_s: step.plan.at_us as f64 * 1e-6,
+                    label: step.label.clone(),
+                    mode: mode_name(step.plan.mode),
+                })
+                .collect(),
+        ),
+        None => (args.drive.clone(), Vec::new()),
+    };
     let model = args.model.unwrap_or_else(|| {
         PathBuf::from(match args.scene {
             Scene::Flat => DEFAULT_MODEL,
@@ -207,7 +234,7 @@ fn run(args: RunArgs) -> Result<(), String> {
             Mode::Lockstep => Clock::Lockstep,
             Mode::Realtime => Clock::Realtime,
         },
-        duration_s: args.duration,
+        duration_s: duration,
         control_hz: args.control_hz,
         reply_timeout: Duration::from_millis(args.reply_timeout_ms),
         imu_noise: ImuNoise {
@@ -217,7 +244,7 @@ fn run(args: RunArgs) -> Result<(), String> {
             seed: args.seed,
             ..ImuNoise::default()
         },
-        teleop_plan: args.drive,
+        teleop_plan,
         out_dir: Some(args.out.clone()),
         plots: !args.no_plots,
         progress: true,
@@ -227,6 +254,7 @@ fn run(args: RunArgs) -> Result<(), String> {
         }),
         viewer: args.viewer,
         stop: Some(stop_on_ctrl_c()),
+        segments,
     };
     tracing::info!(model = %config.model.display(), bus = %args.bus, "starting");
     let report = session::run(&config).map_err(|e| e.to_string())?;
@@ -267,6 +295,18 @@ fn run(args: RunArgs) -> Result<(), String> {
             row.torso_rpy_deg[1],
             row.torso_rpy_deg[2]
         );
+    }
+    if let Some(s) = &scenario {
+        let path = args.out.join("summary.json");
+        let clock = match args.mode {
+            Mode::Lockstep => "lockstep",
+            Mode::Realtime => "realtime",
+        };
+        Summary::from_stats(&s.name, &args.bus, clock, &report.stats, &report.segments)
+            .write(&path)
+            .map_err(|e| e.to_string())?;
+        println!("\n{}", summary::table(&report.segments));
+        println!("wrote            {}", path.display());
     }
     if let Some(first) = report.frames.first() {
         println!(

@@ -18,6 +18,8 @@ pub struct TorsoState {
     pub quat_wxyz: [f64; 4],
     /// Linear velocity of the torso centre, world frame, m/s.
     pub vel_m_s: [f64; 3],
+    /// Angular velocity, torso frame, rad/s.
+    pub ang_vel_rad_s: [f64; 3],
 }
 
 impl TorsoState {
@@ -48,6 +50,8 @@ pub struct GroundContacts {
     pub feet: [bool; 4],
     /// Any other part of the robot: torso, a leg link.
     pub other: bool,
+    /// The torso box itself.
+    pub torso: bool,
 }
 
 /// A loaded model and its state.
@@ -227,6 +231,7 @@ impl Physics {
             pos_m: [q[0], q[1], q[2]],
             quat_wxyz: [q[3], q[4], q[5], q[6]],
             vel_m_s: [v[0], v[1], v[2]],
+            ang_vel_rad_s: [v[3], v[4], v[5]],
         }
     }
 
@@ -282,6 +287,8 @@ impl Physics {
                 contacts.feet[f] = true;
             } else {
                 contacts.other = true;
+                contacts.torso |=
+                    body_of.get(part).map(|b| *b as usize) == Some(self.layout.torso_body);
             }
         }
         contacts

@@ -27,7 +27,7 @@ pub fn run(
     recorder: &mut Recorder,
     options: RealtimeOptions,
     mut peers: impl FnMut(u32) -> Result<(), RunError>,
-    mut observe: impl FnMut(&Simulator) -> bool,
+    mut observe: impl FnMut(&Simulator, &RunStats) -> bool,
 ) -> Result<RunStats, RunError> {
     let started = Instant::now();
     let mut stats = RunStats::default();
@@ -52,7 +52,7 @@ pub fn run(
         }
         peers(sim.cycle())?;
         recorder.row(sim.telemetry());
-        if !observe(sim) {
+        if !observe(sim, &stats) {
             break;
         }
         let deadline = started + options.period.mul_f64((n + 1) as f64);

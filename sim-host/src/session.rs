@@ -2,8 +2,10 @@
 //! (with the firmware in-process on the in-process bus), run it in lockstep or real time, and
 //! leave the telemetry CSV, the candump log and the plots in an output folder.
 
+use std::cell::Cell;
 use std::num::NonZeroU32;
 use std::path::PathBuf;
+use std::rc::Rc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::Duration;
@@ -15,6 +17,7 @@ use crate::imu::ImuNoise;
 use crate::inproc_bus::InprocBus;
 use crate::inproc_controller::InprocController;
 use crate::lockstep::{self, LockstepOptions};
+use crate::metrics::{BusCounters, SegmentSummary, SegmentTracker};
 use crate::model::ModelError;
 use crate::output_error::OutputError;
 use crate::realtime::{self, RealtimeOptions};
@@ -79,11 +82,24 @@ pub struct SessionConfig {
     pub progress: bool,
     /// Set (by a Ctrl-C handler, say) to end the run early; the outputs are still written.
     pub stop: Option<Arc<AtomicBool>>,
+    /// Segments to summarise, in time order (empty: the whole run is one segment).
+    pub segments: Vec<SegmentSpec>,
     /// Frames to render (`None`: none). Without the `renderer` feature, `Some` is an error.
     pub frames: Option<FrameSettings>,
     /// Open the MuJoCo viewer, synced every cycle, and keep it open after the run until it is
     /// closed (closing it early ends the run). Without the `viewer` feature, `true` is an error.
     pub viewer: bool,
+}
+
+/// Where a segment of the run starts and what it is called.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SegmentSpec {
+    /// Start, s.
+    pub start_s: f64,
+    /// Name in the summary.
+    pub label: String,
+    /// Commanded mode (W S A L K X, stand, fold).
+    pub mode: String,
 }
 
 /// Why a session failed.
@@ -143,6 +159,8 @@ pub struct SessionReport {
     pub frames: Vec<PathBuf>,
     /// Whether [`SessionConfig::stop`] ended the run early.
     pub interrupted: bool,
+    /// Figures per segment.
+    pub segments: Vec<SegmentSummary>,
 }
 
 /// Runs one session.
@@ -177,7 +195,48 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
     let mut watch_error = None;
     let progress = progress_bar(config.progress, cycles);
     let mut interrupted = false;
-    let mut observe = |s: &Simulator| {
+    let firmware_counters = Rc::new(Cell::new(([0_u64; 6], 0_u64)));
+    let specs: Vec<SegmentSpec> = if config.segments.is_empty() {
+        vec![SegmentSpec {
+            start_s: 0.0,
+            label: "run".into(),
+            mode: String::new(),
+        }]
+    } else {
+        config.segments.clone()
+    };
+    let mut segments: Vec<SegmentSummary> = Vec::new();
+    let mut tracker: Option<(usize, SegmentTracker)> = None;
+    let counters_in_observe = Rc::clone(&firmware_counters);
+    let bus_counters = move |s: &Simulator, stats: &RunStats| {
+        let (firmware_rejected, firmware_lost) = counters_in_observe.get();
+        BusCounters {
+            frames_sent: stats.frames_sent,
+            frames_received: stats.frames_received,
+            firmware_rejected,
+            firmware_lost,
+            drives_rejected: s.hardware().rejected(),
+            missed_cycles: stats.missed_cycles,
+        }
+    };
+    let mut observe = |s: &Simulator, stats: &RunStats| {
+        let counters = bus_counters(s, stats);
+        let due = specs
+            .iter()
+            .rposition(|spec| spec.start_s <= s.time_s() + 1e-9)
+            .unwrap_or(0);
+        match &mut tracker {
+            Some((index, current)) if *index == due => current.observe(s, counters),
+            _ => {
+                if let Some((_, done)) = tracker.take() {
+                    segments.push(done.finish());
+                }
+                let spec = &specs[due];
+                let mut fresh = SegmentTracker::start(&spec.label, &spec.mode, s, counters);
+                fresh.observe(s, counters);
+                tracker = Some((due, fresh));
+            }
+        }
         if u64::from(s.cycle()) % 25 == 0 {
             progress.set_position(u64::from(s.cycle()));
         }
@@ -214,6 +273,11 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
                     }
                 }
                 controller.service(cycle)?;
+                let counters = controller.node().reject_counters();
+                firmware_counters.set((
+                    counters.rejected.map(|n| u64::from(n.raw())),
+                    u64::from(counters.lost.raw()),
+                ));
                 Ok(())
             };
             let stats = drive(
@@ -255,6 +319,10 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         }
     };
     progress.finish_and_clear();
+    drop(observe);
+    if let Some((_, done)) = tracker.take() {
+        segments.push(done.finish());
+    }
     if let Some(e) = watch_error {
         return Err(e);
     }
@@ -277,6 +345,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         drives_rejected,
         frames,
         interrupted,
+        segments,
     })
 }
 
@@ -367,7 +436,7 @@ fn drive(
     config: &SessionConfig,
     cycles: u64,
     peers: impl FnMut(u32) -> Result<(), RunError>,
-    observe: impl FnMut(&Simulator) -> bool,
+    observe: impl FnMut(&Simulator, &RunStats) -> bool,
 ) -> Result<RunStats, RunError> {
     match config.clock {
         Clock::Lockstep => lockstep::run(

@@ -149,7 +149,7 @@ fn run(
             controller.borrow_mut().service();
             Ok(())
         },
-        |s| {
+        |s, _| {
             each(s);
             true
         },

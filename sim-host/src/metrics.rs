@@ -1,0 +1,249 @@
+//! What a user checks after a run, per segment of a scenario, from the simulator's ground
+//! truth: how far and which way the robot went, how much it tilted, whether it fell, whether a
+//! joint or torque went past its limit, what touched the ground, and the bus traffic.
+
+use serde::Serialize;
+
+use crate::simulator::Simulator;
+
+/// A joint counts as past its limit beyond this, rad (MuJoCo's limits are soft constraints:
+/// a loaded joint presses a fraction of a degree into them).
+pub const JOINT_TOLERANCE_RAD: f64 = 0.0175;
+/// Ground speed below which the robot counts as stopped, m/s.
+pub const STOPPED_M_S: f64 = 0.05;
+/// Yaw rate below which the robot counts as stopped, rad/s.
+pub const STOPPED_RAD_S: f64 = 0.1;
+/// Tilt beyond which the robot has fallen, degrees (the controller's own limit).
+pub const FALLEN_TILT_DEG: f64 = 45.0;
+/// Foot load that counts as contact, N.
+pub const FOOT_CONTACT_N: f64 = 20.0;
+
+/// Frames seen on the bus, cumulative.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct BusCounters {
+    /// Frames the simulator sent.
+    pub frames_sent: u64,
+    /// Frames the simulator received.
+    pub frames_received: u64,
+    /// Frames the firmware rejected, by cause: unknown id, wrong length, CRC, out of range,
+    /// repeated, wrong sequence.
+    pub firmware_rejected: [u64; 6],
+    /// Frames the firmware found missing from sequences.
+    pub firmware_lost: u64,
+    /// Frames the drives rejected.
+    pub drives_rejected: u64,
+    /// Lockstep cycles whose command came late.
+    pub missed_cycles: u64,
+}
+
+impl BusCounters {
+    fn since(&self, start: &BusCounters) -> BusCounters {
+        BusCounters {
+            frames_sent: self.frames_sent - start.frames_sent,
+            frames_received: self.frames_received - start.frames_received,
+            firmware_rejected: std::array::from_fn(|i| {
+                self.firmware_rejected[i] - start.firmware_rejected[i]
+            }),
+            firmware_lost: self.firmware_lost - start.firmware_lost,
+            drives_rejected: self.drives_rejected - start.drives_rejected,
+            missed_cycles: self.missed_cycles - start.missed_cycles,
+        }
+    }
+}
+
+/// One segment's figures (serialised into `summary.json`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SegmentSummary {
+    /// Segment name.
+    pub label: String,
+    /// Commanded mode: W S A L K X, stand, fold.
+    pub mode: String,
+    /// Start, s.
+    pub start_s: f64,
+    /// End, s.
+    pub end_s: f64,
+    /// Torso displacement in the world frame, m.
+    pub dx_m: f64,
+    /// Torso displacement in the world frame, m.
+    pub dy_m: f64,
+    /// Displacement along the torso's heading at the segment start (+ = forward), m.
+    pub forward_m: f64,
+    /// Displacement across that heading (+ = left), m.
+    pub lateral_m: f64,
+    /// Yaw change, unwrapped, degrees (+ = left).
+    pub dyaw_deg: f64,
+    /// Largest torso tilt (angle of its up axis from vertical), degrees.
+    pub max_tilt_deg: f64,
+    /// Largest |roll|, degrees.
+    pub max_roll_deg: f64,
+    /// Largest |pitch|, degrees.
+    pub max_pitch_deg: f64,
+    /// Lowest torso-centre height, m.
+    pub min_height_m: f64,
+    /// Torso height at the end, m.
+    pub end_height_m: f64,
+    /// Whether the robot fell (tilt past 45° or the torso on the ground).
+    pub fell: bool,
+    /// Cycles with a leg joint more than 1° past its range.
+    pub joint_limit_violations: u64,
+    /// Largest excess of a leg joint past its range, degrees (0 inside).
+    pub max_joint_excess_deg: f64,
+    /// Cycles with a wheel torque past the limit.
+    pub torque_limit_violations: u64,
+    /// Largest applied wheel torque, N·m.
+    pub max_wheel_torque_nm: f64,
+    /// Cycles in which a foot or a body part touched the ground.
+    pub feet_or_body_on_ground_cycles: u64,
+    /// Cycles in which a body part (torso, leg link) touched the ground.
+    pub body_on_ground_cycles: u64,
+    /// Cycles in which the torso box touched the ground.
+    pub torso_on_ground_cycles: u64,
+    /// Cycles in which both feet of one side or of one end carried the robot while a foot of
+    /// the other diagonal was off the ground (not a trot's diagonal support).
+    pub non_diagonal_support_cycles: u64,
+    /// Cycles in the segment.
+    pub cycles: u64,
+    /// Time from the segment start until the robot stood still (< 0.05 m/s, < 0.1 rad/s) and
+    /// stayed so to the end; `None` if it never did.
+    pub settled_after_s: Option<f64>,
+    /// Bus traffic in the segment.
+    pub bus: BusCounters,
+}
+
+/// Accumulates a segment's figures cycle by cycle.
+#[derive(Debug, Clone)]
+pub struct SegmentTracker {
+    summary: SegmentSummary,
+    start_pos: [f64; 3],
+    start_yaw: f64,
+    last_yaw: f64,
+    start_bus: BusCounters,
+    limits: [(f64, f64); 4],
+    wheel_limit_nm: f64,
+    last_moving_s: Option<f64>,
+}
+
+impl SegmentTracker {
+    /// Starts a segment on the simulator's present state.
+    pub fn start(label: &str, mode: &str, sim: &Simulator, bus: BusCounters) -> Self {
+        let config = firmware::config::Config::ROBOT;
+        let limits = config
+            .limits
+            .ranges
+            .map(|r| (f64::from(r.min_rad), f64::from(r.max_rad)));
+        let torso = sim.physics().torso();
+        let yaw = torso.rpy_rad()[2];
+        Self {
+            summary: SegmentSummary {
+                label: label.to_owned(),
+                mode: mode.to_owned(),
+                start_s: sim.time_s(),
+                end_s: sim.time_s(),
+                dx_m: 0.0,
+                dy_m: 0.0,
+                forward_m: 0.0,
+                lateral_m: 0.0,
+                dyaw_deg: 0.0,
+                max_tilt_deg: 0.0,
+                max_roll_deg: 0.0,
+                max_pitch_deg: 0.0,
+                min_height_m: torso.pos_m[2],
+                end_height_m: torso.pos_m[2],
+                fell: false,
+                joint_limit_violations: 0,
+                max_joint_excess_deg: 0.0,
+                torque_limit_violations: 0,
+                max_wheel_torque_nm: 0.0,
+                feet_or_body_on_ground_cycles: 0,
+                body_on_ground_cycles: 0,
+                torso_on_ground_cycles: 0,
+                non_diagonal_support_cycles: 0,
+                cycles: 0,
+                settled_after_s: None,
+                bus: BusCounters::default(),
+            },
+            start_pos: torso.pos_m,
+            start_yaw: yaw,
+            last_yaw: yaw,
+            start_bus: bus,
+            limits,
+            wheel_limit_nm: f64::from(config.wheel_torque_limit_nm),
+            last_moving_s: Some(sim.time_s()),
+        }
+    }
+
+    /// Takes one cycle's state.
+    pub fn observe(&mut self, sim: &Simulator, bus: BusCounters) {
+        let s = &mut self.summary;
+        let physics = sim.physics();
+        let torso = physics.torso();
+        let [roll, pitch, yaw] = torso.rpy_rad();
+        let step = (yaw - self.last_yaw + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        self.last_yaw = yaw;
+        s.dyaw_deg += step.to_degrees();
+        s.end_s = sim.time_s();
+        s.cycles += 1;
+        let dx = torso.pos_m[0] - self.start_pos[0];
+        let dy = torso.pos_m[1] - self.start_pos[1];
+        s.dx_m = dx;
+        s.dy_m = dy;
+        let (sin_h, cos_h) = self.start_yaw.sin_cos();
+        s.forward_m = dx * cos_h + dy * sin_h;
+        s.lateral_m = -dx * sin_h + dy * cos_h;
+        let tilt = torso.tilt_rad().to_degrees();
+        s.max_tilt_deg = s.max_tilt_deg.max(tilt);
+        s.max_roll_deg = s.max_roll_deg.max(roll.to_degrees().abs());
+        s.max_pitch_deg = s.max_pitch_deg.max(pitch.to_degrees().abs());
+        s.min_height_m = s.min_height_m.min(torso.pos_m[2]);
+        s.end_height_m = torso.pos_m[2];
+        let contacts = physics.ground_contacts();
+        s.fell |= tilt > FALLEN_TILT_DEG || contacts.torso;
+        let mut excess: f64 = 0.0;
+        for (i, angle) in physics.leg_positions_rad().iter().enumerate() {
+            let (lo, hi) = self.limits[i % 4];
+            excess = excess.max(lo - angle).max(angle - hi);
+        }
+        s.max_joint_excess_deg = s.max_joint_excess_deg.max(excess.max(0.0).to_degrees());
+        if excess > JOINT_TOLERANCE_RAD {
+            s.joint_limit_violations += 1;
+        }
+        let torque = sim.hardware().wheel_torque_nm(sim.now_us());
+        let largest = torque.iter().fold(0.0_f64, |m, t| m.max(t.abs()));
+        s.max_wheel_torque_nm = s.max_wheel_torque_nm.max(largest);
+        if largest > self.wheel_limit_nm + 1e-6 {
+            s.torque_limit_violations += 1;
+        }
+        let loaded = physics.foot_forces_n().map(|f| f > FOOT_CONTACT_N);
+        if loaded.iter().any(|l| *l) || contacts.other {
+            s.feet_or_body_on_ground_cycles += 1;
+        }
+        if contacts.other {
+            s.body_on_ground_cycles += 1;
+        }
+        if contacts.torso {
+            s.torso_on_ground_cycles += 1;
+        }
+        let [fl, fr, bl, br] = loaded;
+        let diagonal_broken = !(fl && br) && !(fr && bl);
+        if diagonal_broken && ((fl && fr) || (bl && br) || (fl && bl) || (fr && br)) {
+            s.non_diagonal_support_cycles += 1;
+        }
+        let speed = torso.vel_m_s[0].hypot(torso.vel_m_s[1]);
+        let yaw_rate = torso.ang_vel_rad_s[2].abs();
+        if speed >= STOPPED_M_S || yaw_rate >= STOPPED_RAD_S {
+            self.last_moving_s = Some(sim.time_s());
+        }
+        s.bus = bus.since(&self.start_bus);
+    }
+
+    /// The segment's figures.
+    pub fn finish(mut self) -> SegmentSummary {
+        self.summary.settled_after_s = match self.last_moving_s {
+            Some(t) if t >= self.summary.end_s => None,
+            Some(t) => Some((t - self.summary.start_s).max(0.0)),
+            None => Some(0.0),
+        };
+        self.summary
+    }
+}

@@ -1,0 +1,281 @@
+//! Scenario files: what an operator commands, and when. A user writes them; errors name the file
+//! and line.
+//!
+//! ```toml
+//! name = "wheels forward"
+//! duration_s = 8.0            # simulated time; the last segment runs until then
+//!
+//! [[step]]
+//! at_s = 0.0
+//! mode = "fold"               # W S A L K X (the report's keys), stand, fold
+//!
+//! [[step]]
+//! at_s = 3.0
+//! mode = "W"
+//! body_height_m = 0.0         # optional, −0.10…+0.12 (default 0)
+//! speed_scale_pct = 100       # optional, 0…100 (default 100)
+//! label = "drive"             # optional name of the segment in the summary
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use protocol::TeleopMode;
+use serde::Deserialize;
+use toml::Spanned;
+
+use crate::scripted_teleop::PlanStep;
+
+/// One operator command and the segment it starts.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Step {
+    /// The command, as the teleop sends it.
+    pub plan: PlanStep,
+    /// Segment name for the summary.
+    pub label: String,
+}
+
+/// A parsed scenario.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scenario {
+    /// Its name.
+    pub name: String,
+    /// Simulated time, s.
+    pub duration_s: f64,
+    /// Steps, in time order.
+    pub steps: Vec<Step>,
+}
+
+/// Why a scenario file was refused.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ScenarioError {
+    /// The file could not be read.
+    #[error("cannot read the scenario {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The OS error.
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML or has a wrong field.
+    #[error("{}:{line}: {message}", path.display())]
+    Syntax {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value is outside what the robot accepts.
+    #[error("{}:{line}: {message}", path.display())]
+    Value {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line.
+        line: usize,
+        /// What is wrong and what is allowed.
+        message: String,
+    },
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScenario {
+    name: Option<String>,
+    duration_s: Spanned<f64>,
+    #[serde(default)]
+    step: Vec<Spanned<RawStep>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawStep {
+    at_s: Spanned<f64>,
+    mode: Spanned<String>,
+    body_height_m: Option<Spanned<f64>>,
+    speed_scale_pct: Option<Spanned<f64>>,
+    label: Option<String>,
+}
+
+/// The mode a scenario (or `--drive`) names: the report's keys W S A L K X, `stand`, `fold`.
+pub fn parse_mode(text: &str) -> Option<TeleopMode> {
+    match text.trim().to_ascii_lowercase().as_str() {
+        "stand" => Some(TeleopMode::Stand),
+        "fold" => Some(TeleopMode::Fold),
+        key => {
+            let mut chars = key.chars();
+            match (chars.next(), chars.next()) {
+                (Some(c), None) => TeleopMode::from_key(c),
+                _ => None,
+            }
+        }
+    }
+}
+
+/// The label of a mode in summaries: the report's key, or `stand` / `fold`.
+pub fn mode_name(mode: TeleopMode) -> String {
+    match mode {
+        TeleopMode::Stand => "stand".into(),
+        TeleopMode::Fold => "fold".into(),
+        other => other.key().map(String::from).unwrap_or_default(),
+    }
+}
+
+impl Scenario {
+    /// Reads and checks `path`.
+    pub fn load(path: &Path) -> Result<Self, ScenarioError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Read {
+            path: path.to_owned(),
+            source,
+        })?;
+        Self::parse(path, &text)
+    }
+
+    /// Parses `text` (named `path` in errors).
+    pub fn parse(path: &Path, text: &str) -> Result<Self, ScenarioError> {
+        let line_of = |offset: usize| {
+            text.get(..offset).map_or(1, |s| {
+                s.lines().count().max(1) + usize::from(s.ends_with('\n'))
+            })
+        };
+        let raw: RawScenario = toml::from_str(text).map_err(|e| ScenarioError::Syntax {
+            path: path.to_owned(),
+            line: e.span().map_or(1, |span| line_of(span.start)),
+            message: e.message().trim().to_owned(),
+        })?;
+        let value_error = |offset: usize, message: String| ScenarioError::Value {
+            path: path.to_owned(),
+            line: line_of(offset),
+            message,
+        };
+        let duration_s = *raw.duration_s.get_ref();
+        if !(duration_s.is_finite() && duration_s > 0.0 && duration_s <= 86_400.0) {
+            return Err(value_error(
+                raw.duration_s.span().start,
+                format!("duration_s = {duration_s}: give 0 < duration_s ≤ 86400 s"),
+            ));
+        }
+        if raw.step.is_empty() {
+            return Err(value_error(
+                0,
+                "no [[step]]: give at least one command".into(),
+            ));
+        }
+        let mut steps = Vec::with_capacity(raw.step.len());
+        let mut previous_s = -1.0;
+        for step in &raw.step {
+            let s = step.get_ref();
+            let at_s = *s.at_s.get_ref();
+            if !(at_s.is_finite() && at_s >= 0.0 && at_s < duration_s) {
+                return Err(value_error(
+                    s.at_s.span().start,
+                    format!("at_s = {at_s}: steps start at 0 ≤ at_s < duration_s ({duration_s} s)"),
+                ));
+            }
+            if at_s <= previous_s {
+                return Err(value_error(
+                    s.at_s.span().start,
+                    format!("at_s = {at_s} is not after the previous step's {previous_s} s"),
+                ));
+            }
+            previous_s = at_s;
+            let mode = parse_mode(s.mode.get_ref()).ok_or_else(|| {
+                value_error(
+                    s.mode.span().start,
+                    format!(
+                        "mode = \"{}\": use W, S, A, L, K, X, stand or fold",
+                        s.mode.get_ref()
+                    ),
+                )
+            })?;
+            let body_height_m = match &s.body_height_m {
+                Some(h) if !(-0.10..=0.12).contains(h.get_ref()) => {
+                    return Err(value_error(
+                        h.span().start,
+                        format!(
+                            "body_height_m = {}: the range is −0.10…+0.12 m",
+                            h.get_ref()
+                        ),
+                    ))
+                }
+                Some(h) => *h.get_ref(),
+                None => 0.0,
+            };
+            let speed_scale_pct = match &s.speed_scale_pct {
+                Some(v) if !(0.0..=100.0).contains(v.get_ref()) => {
+                    return Err(value_error(
+                        v.span().start,
+                        format!("speed_scale_pct = {}: the range is 0…100", v.get_ref()),
+                    ))
+                }
+                Some(v) => *v.get_ref(),
+                None => 100.0,
+            };
+            steps.push(Step {
+                plan: PlanStep {
+                    at_us: (at_s * 1e6).round() as u64,
+                    mode,
+                    body_height_m: body_height_m as f32,
+                    speed_scale_pct: speed_scale_pct as f32,
+                },
+                label: s.label.clone().unwrap_or_else(|| mode_name(mode)),
+            });
+        }
+        Ok(Self {
+            name: raw.name.unwrap_or_else(|| {
+                path.file_stem()
+                    .map_or_else(String::new, |s| s.to_string_lossy().into_owned())
+            }),
+            duration_s,
+            steps,
+        })
+    }
+
+    /// The operator's plan.
+    pub fn plan(&self) -> Vec<PlanStep> {
+        self.steps.iter().map(|s| s.plan).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Scenario, ScenarioError> {
+        Scenario::parse(Path::new("test.toml"), text)
+    }
+
+    #[test]
+    fn a_scenario_reads_its_steps_in_order() {
+        let s = parse(
+            "name = \"x\"\nduration_s = 6\n[[step]]\nat_s = 0\nmode = \"fold\"\n[[step]]\nat_s = 2.5\nmode = \"w\"\nspeed_scale_pct = 50\nlabel = \"go\"\n",
+        )
+        .unwrap();
+        assert_eq!(s.steps.len(), 2);
+        assert_eq!(s.steps[0].plan.mode, TeleopMode::Fold);
+        assert_eq!(s.steps[1].plan.at_us, 2_500_000);
+        assert_eq!(s.steps[1].plan.speed_scale_pct, 50.0);
+        assert_eq!(s.steps[1].label, "go");
+        assert_eq!(s.steps[0].label, "fold");
+    }
+
+    #[test]
+    fn errors_name_the_line() {
+        let cases = [
+            ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"Q\"\n", 4, "use W, S, A"),
+            ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"W\"\n[[step]]\nat_s = 0\nmode = \"X\"\n", 6, "not after"),
+            ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"W\"\nbody_height_m = 0.3\n", 5, "−0.10…+0.12"),
+            ("duration_s = 6\n[[step]]\nat_s = 9\nmode = \"W\"\n", 3, "duration_s"),
+            ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"W\"\nspeed = 3\n", 5, "unknown field"),
+            ("duration_s = 6\n[[step]\nat_s = 0\n", 2, ""),
+            ("duration_s = -1\n[[step]]\nat_s = 0\nmode = \"W\"\n", 1, "0 < duration_s"),
+        ];
+        for (text, line, needle) in cases {
+            let err = parse(text).unwrap_err();
+            let shown = err.to_string();
+            assert!(shown.starts_with(&format!("test.toml:{line}: ")), "{shown}");
+            assert!(shown.contains(needle), "{shown}");
+        }
+    }
+}
