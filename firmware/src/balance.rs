@@ -72,10 +72,10 @@ pub struct BalanceGains {
 impl BalanceGains {
     /// LQR gains for [`BalanceModel::ROBOT`] at 250 Hz (see the module docs).
     pub const ROBOT: Self = Self {
-        position_nm_per_m: -134.6791,
-        pitch_nm_per_rad: -443.5006,
-        velocity_nm_per_m_s: -160.1927,
-        pitch_rate_nm_per_rad_s: -84.5932,
+        position_nm_per_m: -258.5094,
+        pitch_nm_per_rad: -610.3082,
+        velocity_nm_per_m_s: -278.9801,
+        pitch_rate_nm_per_rad_s: -130.7839,
     };
 
     /// As an array `[p, θ, v, θ̇]`.
@@ -110,7 +110,14 @@ pub struct BalanceConfig {
     /// The speed reference slows down at most this fast, m/s²: higher than the acceleration
     /// limit, so that a stop is quick; the lean it costs is brief.
     pub brake_limit_m_s2: f32,
+    /// Viscous friction of one wheel's drive, N·m per rad/s (the report's joint damping 2):
+    /// fed forward at the reference speed, so that driving does not need a standing position
+    /// error (which the robot would make up by overshooting, and give back after a stop).
+    pub wheel_viscous_nm_per_rad_s: f32,
 }
+
+/// Ground speed below which a braking robot counts as stopped, m/s.
+const STOPPED_M_S: f32 = 0.02;
 
 /// What the balance law reads each tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -131,6 +138,10 @@ pub struct Balance {
     config: BalanceConfig,
     position_error_m: f32,
     velocity_ref_m_s: f32,
+    /// Ground speed seen last tick, m/s.
+    last_speed_m_s: f32,
+    /// Whether the position is held where the robot came to rest (see [`Balance::update`]).
+    anchored: bool,
 }
 
 impl Balance {
@@ -140,6 +151,8 @@ impl Balance {
             config,
             position_error_m: 0.0,
             velocity_ref_m_s: 0.0,
+            last_speed_m_s: 0.0,
+            anchored: true,
         }
     }
 
@@ -147,6 +160,8 @@ impl Balance {
     pub fn reset(&mut self) {
         self.position_error_m = 0.0;
         self.velocity_ref_m_s = 0.0;
+        self.last_speed_m_s = 0.0;
+        self.anchored = true;
     }
 
     /// The speed reference after the acceleration limit, m/s.
@@ -188,6 +203,22 @@ impl Balance {
             return 0.0;
         }
         self.velocity_ref_m_s = velocity_ref;
+        // A stop holds the robot where it came to rest, not where the speed reference did:
+        // the robot lags the reference while braking, and rolling back to the reference's stop
+        // point would be a second motion nobody asked for. So once the reference is at rest
+        // and the robot's own speed has come to zero (or changed sign), the remembered
+        // position error is dropped, once per stop.
+        let speed = self.ground_speed_m_s(input);
+        if input.velocity_ref_m_s == 0.0 && velocity_ref == 0.0 {
+            let stopped = speed * self.last_speed_m_s <= 0.0 || speed.abs() < STOPPED_M_S;
+            if !self.anchored && stopped {
+                self.position_error_m = 0.0;
+                self.anchored = true;
+            }
+        } else {
+            self.anchored = false;
+        }
+        self.last_speed_m_s = speed;
         let k = self.config.gains;
         let limit = self.config.torque_limit_nm;
         let torque_at = |position_error_m: f32| {
@@ -207,6 +238,12 @@ impl Balance {
         if !(saturated && grows) {
             self.position_error_m = candidate;
         }
-        crate::math::clamp(torque_at(self.position_error_m), -limit, limit)
+        let feedforward = 2.0 * self.config.wheel_viscous_nm_per_rad_s * velocity_ref
+            / self.config.wheel_radius_m;
+        crate::math::clamp(
+            torque_at(self.position_error_m) + feedforward,
+            -limit,
+            limit,
+        )
     }
 }

@@ -130,6 +130,11 @@ impl Controller {
         &self.sensors
     }
 
+    /// The balance law (its speed reference and position error).
+    pub fn balance(&self) -> &Balance {
+        &self.balance
+    }
+
     /// The trot generator (its phase).
     pub fn trot(&self) -> &Trot {
         &self.trot

@@ -9,10 +9,11 @@ use crate::simulator::Simulator;
 /// A joint counts as past its limit beyond this, rad (MuJoCo's limits are soft constraints:
 /// a loaded joint presses a fraction of a degree into them).
 pub const JOINT_TOLERANCE_RAD: f64 = 0.0175;
-/// Ground speed below which the robot counts as stopped, m/s.
-pub const STOPPED_M_S: f64 = 0.05;
-/// Yaw rate below which the robot counts as stopped, rad/s.
-pub const STOPPED_RAD_S: f64 = 0.1;
+/// The robot has stopped once its torso stays this close to where it ends, m (a legged robot
+/// sways on its servos after it stops walking; a balancing one rocks on its wheels).
+pub const STOPPED_RADIUS_M: f64 = 0.03;
+/// … and its heading this close to its final heading, degrees.
+pub const STOPPED_YAW_DEG: f64 = 3.0;
 /// Tilt beyond which the robot has fallen, degrees (the controller's own limit).
 pub const FALLEN_TILT_DEG: f64 = 45.0;
 /// Foot load that counts as contact, N.
@@ -98,14 +99,18 @@ pub struct SegmentSummary {
     pub body_on_ground_cycles: u64,
     /// Cycles in which the torso box touched the ground.
     pub torso_on_ground_cycles: u64,
-    /// Cycles in which both feet of one side or of one end carried the robot while a foot of
-    /// the other diagonal was off the ground (not a trot's diagonal support).
+    /// Cycles in which exactly two feet carried the robot and they were not a diagonal pair
+    /// (not a trot's support).
     pub non_diagonal_support_cycles: u64,
     /// Cycles in the segment.
     pub cycles: u64,
-    /// Time from the segment start until the robot stood still (< 0.05 m/s, < 0.1 rad/s) and
-    /// stayed so to the end; `None` if it never did.
+    /// Time from the segment start after which the torso stayed within 3 cm and 3° of where it
+    /// ended: when the robot stopped. `None` if it was still moving at the end (the last tenth
+    /// of a second left that band).
     pub settled_after_s: Option<f64>,
+    /// Largest distance of the torso, from 1 s into the segment on, from where it was at 1 s,
+    /// m: how far a robot told to stop still goes after the first second.
+    pub moved_after_1s_m: f64,
     /// Bus traffic in the segment.
     pub bus: BusCounters,
 }
@@ -120,7 +125,8 @@ pub struct SegmentTracker {
     start_bus: BusCounters,
     limits: [(f64, f64); 4],
     wheel_limit_nm: f64,
-    last_moving_s: Option<f64>,
+    /// (time s, x m, y m, unwrapped yaw deg) of every cycle.
+    track: Vec<(f64, f64, f64, f64)>,
 }
 
 impl SegmentTracker {
@@ -160,6 +166,7 @@ impl SegmentTracker {
                 non_diagonal_support_cycles: 0,
                 cycles: 0,
                 settled_after_s: None,
+                moved_after_1s_m: 0.0,
                 bus: BusCounters::default(),
             },
             start_pos: torso.pos_m,
@@ -168,7 +175,7 @@ impl SegmentTracker {
             start_bus: bus,
             limits,
             wheel_limit_nm: f64::from(config.wheel_torque_limit_nm),
-            last_moving_s: Some(sim.time_s()),
+            track: Vec::new(),
         }
     }
 
@@ -225,25 +232,37 @@ impl SegmentTracker {
             s.torso_on_ground_cycles += 1;
         }
         let [fl, fr, bl, br] = loaded;
-        let diagonal_broken = !(fl && br) && !(fr && bl);
-        if diagonal_broken && ((fl && fr) || (bl && br) || (fl && bl) || (fr && br)) {
+        let feet_down = loaded.iter().filter(|l| **l).count();
+        let diagonal = (fl && br) || (fr && bl);
+        if feet_down == 2 && !diagonal {
             s.non_diagonal_support_cycles += 1;
         }
-        let speed = torso.vel_m_s[0].hypot(torso.vel_m_s[1]);
-        let yaw_rate = torso.ang_vel_rad_s[2].abs();
-        if speed >= STOPPED_M_S || yaw_rate >= STOPPED_RAD_S {
-            self.last_moving_s = Some(sim.time_s());
-        }
+        self.track
+            .push((sim.time_s(), torso.pos_m[0], torso.pos_m[1], s.dyaw_deg));
         s.bus = bus.since(&self.start_bus);
     }
 
     /// The segment's figures.
     pub fn finish(mut self) -> SegmentSummary {
-        self.summary.settled_after_s = match self.last_moving_s {
-            Some(t) if t >= self.summary.end_s => None,
-            Some(t) => Some((t - self.summary.start_s).max(0.0)),
-            None => Some(0.0),
-        };
+        let start_s = self.summary.start_s;
+        if let Some(&(_, x1, y1, _)) = self.track.iter().find(|(t, ..)| *t >= start_s + 1.0) {
+            self.summary.moved_after_1s_m = self
+                .track
+                .iter()
+                .filter(|(t, ..)| *t >= start_s + 1.0)
+                .map(|(_, x, y, _)| (x - x1).hypot(y - y1))
+                .fold(0.0, f64::max);
+        }
+        if let Some(&(end_s, x, y, yaw)) = self.track.last() {
+            let left = self.track.iter().rev().find(|(_, tx, ty, tyaw)| {
+                (tx - x).hypot(ty - y) > STOPPED_RADIUS_M || (tyaw - yaw).abs() > STOPPED_YAW_DEG
+            });
+            self.summary.settled_after_s = match left {
+                None => Some(0.0),
+                Some(&(t, ..)) if end_s - t < 0.1 => None,
+                Some(&(t, ..)) => Some((t - self.summary.start_s).max(0.0)),
+            };
+        }
         self.summary
     }
 }

@@ -319,7 +319,6 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         }
     };
     progress.finish_and_clear();
-    drop(observe);
     if let Some((_, done)) = tracker.take() {
         segments.push(done.finish());
     }
