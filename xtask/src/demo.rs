@@ -1,10 +1,55 @@
-//! `cargo xtask demo`: the report's demonstration, closed loop. Arrives with the closed-loop
-//! issue; until then it says so and fails, so no script takes it for a passing demo.
+//! `cargo xtask demo [--bus vcan0] [--out DIR] [--scenario FILE] [--no-render]`: the report's
+//! demonstration, closed loop. Sets up (MuJoCo, targets, Mesa), builds `sim-host` in release
+//! with the headless renderer, and runs `scenarios/report_demo.toml` — STOP, W, S, A, L, K, X —
+//! with the firmware's control core on the in-process CAN bus (or over SocketCAN with `--bus`).
+//! Leaves `summary.json`, `telemetry.csv`, `bus.log` (candump), the plots and a few rendered
+//! frames in `out/` and prints a table of the segments.
 
-pub fn run() -> Result<(), String> {
-    Err(
-        "not yet: the closed-loop demo lands with the closed-loop issue. \
-         Today you can run `cargo xtask test` and `cargo xtask busload`."
-            .into(),
-    )
+use crate::util::{cargo, root, run as sh};
+
+pub fn run(args: &[String]) -> Result<(), String> {
+    let mut bus = "inproc".to_owned();
+    let mut out = root().join("out");
+    let mut scenario = root().join("scenarios").join("report_demo.toml");
+    let mut render = true;
+    let mut rest = args.iter();
+    while let Some(arg) = rest.next() {
+        let mut value = |name: &str| {
+            rest.next()
+                .cloned()
+                .ok_or_else(|| format!("{name} needs a value"))
+        };
+        match arg.as_str() {
+            "--bus" => bus = value("--bus")?,
+            "--out" => out = value("--out")?.into(),
+            "--scenario" => scenario = value("--scenario")?.into(),
+            "--no-render" => render = false,
+            other => {
+                return Err(format!(
+                    "unknown option `{other}`: use --bus IFNAME, --out DIR, --scenario FILE, --no-render"
+                ))
+            }
+        }
+    }
+    crate::setup::run()?;
+    let mut cmd = cargo();
+    cmd.args(["run", "--release", "--quiet", "-p", "sim-host"]);
+    if render {
+        cmd.args(["--features", "renderer"]);
+    }
+    cmd.args(["--", "run", "--scenario"])
+        .arg(&scenario)
+        .args(["--bus", &bus, "--out"])
+        .arg(&out);
+    if render {
+        // Every 0.5 s of simulated time: a few dozen frames, each ~80 ms on a software renderer.
+        cmd.args(["--render-every", "125"]);
+    }
+    sh(&mut cmd)?;
+    eprintln!(
+        "demo: outputs in {} (summary.json, telemetry.csv, bus.log, *.png{})",
+        out.display(),
+        if render { ", frames/" } else { "" }
+    );
+    Ok(())
 }

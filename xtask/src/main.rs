@@ -27,7 +27,11 @@ Tasks:
   bench [args]       criterion benchmarks (control step, raw MuJoCo step, closed-loop cycle), then a
                      table of medians and steps per second
                      (args go to criterion, e.g. `--measurement-time 3`)
-  demo               run the report's demonstration (not yet: arrives with the closed-loop issue)
+  demo [options]     the report's demonstration, closed loop (STOP, W, S, A, L, K, X): sets up,
+                     builds, runs scenarios/report_demo.toml with the firmware on the in-process
+                     CAN bus; writes out/ (summary.json, telemetry.csv, bus.log, plots, frames)
+                     --bus vcan0   over SocketCAN instead (the controller runs elsewhere)
+                     --out DIR     --scenario FILE     --no-render (skip the rendered frames)
 ";
 
 fn main() -> ExitCode {
@@ -45,7 +49,7 @@ fn main() -> ExitCode {
         "dbc" => dbc::run(rest),
         "busload" => busload::run(),
         "bench" => bench::run_task(rest),
-        "demo" => demo::run(),
+        "demo" => demo::run(rest),
         "help" | "-h" | "--help" => {
             print!("{HELP}");
             Ok(())
