@@ -199,6 +199,13 @@ impl Controller {
                 self.follow_measured();
             }
             State::Hold | State::Fault => {}
+            State::Standing(motion) if self.rolling() => {
+                // Stop on the wheels first: legs that unfold under a rolling robot lift it off
+                // its wheels with its momentum still in it, and it topples (measured: driving
+                // forward at 0.48 m/s, standing up flipped it over). The goal is set, so the
+                // transition is not taken as done, but the legs wait.
+                self.leg_goal(motion, depth_m);
+            }
             State::Legs(motion) | State::Standing(motion) => {
                 self.leg_goal(motion, depth_m);
                 let rate = match self.state {
@@ -299,6 +306,15 @@ impl Controller {
         {
             self.apply(Event::Fault);
         }
+    }
+
+    /// Whether the robot still rolls on its wheels (ground speed above 5 cm/s, or turning) while
+    /// they carry it.
+    fn rolling(&self) -> bool {
+        let r = self.config.balance.wheel_radius_m;
+        let speed_m_s = r * self.sensors.mean_wheel_rate_rad_s();
+        let turn_m_s = r * self.sensors.differential_wheel_rate_rad_s();
+        self.wheels_may_drive() && (speed_m_s.abs() > 0.05 || turn_m_s.abs() > 0.05)
     }
 
     /// On the wheels the balance law always runs; while folding or standing up only once the

@@ -202,3 +202,73 @@ fn x_from_every_mode_stops_within_1_s_and_stays_upright() {
         );
     }
 }
+
+#[test]
+fn every_ordered_pair_of_modes_switched_mid_motion_keeps_the_robot_up_and_in_limits() {
+    let modes = ["W", "S", "A", "L", "K", "X"];
+    let mut failures = Vec::new();
+    for first in modes {
+        for second in modes {
+            if first == second {
+                continue;
+            }
+            let (plan, segments) = plan(&[(0.0, "X"), (0.5, first), (3.5, second)]);
+            let report = session::run(&config(plan, segments, 7.0)).unwrap();
+            for s in &report.segments {
+                let bad = s.fell
+                    || s.joint_limit_violations > 0
+                    || s.torque_limit_violations > 0
+                    || s.torso_on_ground_cycles > 0;
+                println!(
+                    "{first} → {second} [{}]: tilt {:.1}°, joint excess {:.2}°, torque {:.1} N·m{}",
+                    s.label,
+                    s.max_tilt_deg,
+                    s.max_joint_excess_deg,
+                    s.max_wheel_torque_nm,
+                    if bad { "  ← FAIL" } else { "" }
+                );
+                if bad {
+                    failures.push(format!("{first} → {second} in {}: {s:?}", s.label));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{} failures:\n{}", failures.len(), failures.join("\n"));
+}
+
+#[test]
+fn ten_minutes_of_trotting_behave_like_the_first_ten_seconds() {
+    let (plan, _) = plan(&[(0.0, "stand"), (1.0, "L")]);
+    let segment = |start_s: f64, label: &str| SegmentSpec {
+        start_s,
+        label: label.to_owned(),
+        mode: "L".to_owned(),
+    };
+    let segments = vec![
+        SegmentSpec {
+            start_s: 0.0,
+            label: "stand".into(),
+            mode: "stand".into(),
+        },
+        segment(3.0, "first 10 s"),
+        segment(13.0, "middle"),
+        segment(591.0, "last 10 s"),
+    ];
+    let report = session::run(&config(plan, segments, 601.0)).unwrap();
+    assert_eq!(report.stats.missed_cycles, 0);
+    let (first, middle, last) = (&report.segments[1], &report.segments[2], &report.segments[3]);
+    println!(
+        "first 10 s: {:.3} m, tilt {:.1}°; last 10 s: {:.3} m, tilt {:.1}°",
+        first.forward_m, first.max_tilt_deg, last.forward_m, last.max_tilt_deg
+    );
+    for s in [first, middle, last] {
+        assert!(!s.fell, "{s:#?}");
+        assert_eq!(s.joint_limit_violations + s.torque_limit_violations, 0, "{s:#?}");
+        assert_eq!(s.body_on_ground_cycles, 0, "{s:#?}");
+    }
+    // The same gait: the same speed along the heading within 20 %, the same tilt within 3°.
+    assert!(first.forward_m > 0.4, "{first:#?}");
+    let ratio = last.forward_m / first.forward_m;
+    assert!((0.8..1.25).contains(&ratio), "speed ratio {ratio:.2}");
+    assert!((last.max_tilt_deg - first.max_tilt_deg).abs() < 3.0);
+}
