@@ -272,3 +272,32 @@ fn ten_minutes_of_trotting_behave_like_the_first_ten_seconds() {
     assert!((0.8..1.25).contains(&ratio), "speed ratio {ratio:.2}");
     assert!((last.max_tilt_deg - first.max_tilt_deg).abs() < 3.0);
 }
+
+#[test]
+fn body_height_commands_are_held_within_1_cm_where_the_legs_reach() {
+    let posture = firmware::config::Config::ROBOT.posture;
+    let (lowest, highest) = posture.body_height_range_m();
+    let stand_at = |offset_m: f32| {
+        let plan = vec![PlanStep {
+            at_us: 0,
+            mode: protocol::TeleopMode::Stand,
+            body_height_m: offset_m,
+            speed_scale_pct: 100.0,
+        }];
+        let report = session::run(&config(plan, Vec::new(), 3.0)).unwrap();
+        let s = &report.segments[0];
+        assert!(!s.fell && s.joint_limit_violations == 0, "{s:#?}");
+        s.end_height_m
+    };
+    let nominal = stand_at(0.0);
+    for offset in [-0.10_f32, lowest, -0.02, 0.01, highest, 0.12] {
+        let height = stand_at(offset);
+        let realised = offset.clamp(lowest, highest);
+        let change = height - nominal;
+        println!("offset {offset:+.3} m (legs realise {realised:+.3}): torso {height:.4} m, change {change:+.4} m");
+        assert!(
+            (change - f64::from(realised)).abs() <= 0.01,
+            "offset {offset}: the torso moved {change:.4} m for {realised:.4} m"
+        );
+    }
+}
