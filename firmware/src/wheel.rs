@@ -20,7 +20,7 @@ impl SpeedLoopGains {
     /// Turn loop of the robot (wheel inertia ≈ 0.018 kg·m² each, robot yaw inertia ≈ 2 kg·m²
     /// seen through r/track): a 2–3 rad/s bandwidth with a quarter of the wheel torque.
     pub const TURN: Self = Self {
-        kp_nm_per_rad_s: 10.0,
+        kp_nm_per_rad_s: 8.0,
         ki_nm_per_rad: 25.0,
         limit_nm: 24.0,
     };

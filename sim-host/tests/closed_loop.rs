@@ -233,7 +233,12 @@ fn every_ordered_pair_of_modes_switched_mid_motion_keeps_the_robot_up_and_in_lim
             }
         }
     }
-    assert!(failures.is_empty(), "{} failures:\n{}", failures.len(), failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
 }
 
 #[test]
@@ -256,14 +261,22 @@ fn ten_minutes_of_trotting_behave_like_the_first_ten_seconds() {
     ];
     let report = session::run(&config(plan, segments, 601.0)).unwrap();
     assert_eq!(report.stats.missed_cycles, 0);
-    let (first, middle, last) = (&report.segments[1], &report.segments[2], &report.segments[3]);
+    let (first, middle, last) = (
+        &report.segments[1],
+        &report.segments[2],
+        &report.segments[3],
+    );
     println!(
         "first 10 s: {:.3} m, tilt {:.1}°; last 10 s: {:.3} m, tilt {:.1}°",
         first.forward_m, first.max_tilt_deg, last.forward_m, last.max_tilt_deg
     );
     for s in [first, middle, last] {
         assert!(!s.fell, "{s:#?}");
-        assert_eq!(s.joint_limit_violations + s.torque_limit_violations, 0, "{s:#?}");
+        assert_eq!(
+            s.joint_limit_violations + s.torque_limit_violations,
+            0,
+            "{s:#?}"
+        );
         assert_eq!(s.body_on_ground_cycles, 0, "{s:#?}");
     }
     // The same gait: the same speed along the heading within 20 %, the same tilt within 3°.
