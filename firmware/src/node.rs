@@ -127,6 +127,29 @@ impl Node {
         (output, frames)
     }
 
+    /// The frames that stop every drive now — legs torque-free, zero wheel torque — in sequence
+    /// with this node's earlier commands, for a controller that is shutting down (the drives
+    /// would otherwise wait out their command timeout).
+    pub fn stop_frames(&mut self) -> TickFrames {
+        let mut frames = TickFrames::new();
+        let legs = AnyMessage::LegTargets(LegTargets {
+            enable: DriveEnable::Disabled,
+            position: self
+                .controller
+                .sensors()
+                .joint_position_rad
+                .map(Angle::saturating_from_si),
+        });
+        let counter = self.tx.leg_targets.advance();
+        self.push(&mut frames, &legs, counter);
+        let wheels = AnyMessage::WheelCommand(WheelCommand {
+            torque: [Torque::saturating_from_si(0.0); 2],
+        });
+        let counter = self.tx.wheel_command.advance();
+        self.push(&mut frames, &wheels, counter);
+        frames
+    }
+
     fn push(&mut self, frames: &mut TickFrames, message: &AnyMessage, counter: u16) {
         match message.encode(counter) {
             Ok(frame) => {

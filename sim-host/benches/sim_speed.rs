@@ -7,10 +7,10 @@ use std::path::Path;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use firmware_host::bus::Bus;
+use firmware_host::inproc_bus::InprocBus;
 use protocol::TeleopMode;
-use sim_host::bus::Bus;
 use sim_host::imu::ImuNoise;
-use sim_host::inproc_bus::InprocBus;
 use sim_host::inproc_controller::InprocController;
 use sim_host::lockstep::{self, LockstepOptions};
 use sim_host::model::DEFAULT_MODEL;

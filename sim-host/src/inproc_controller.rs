@@ -6,8 +6,8 @@ use firmware::controller::ConfigError;
 use firmware::node::Node;
 use firmware::time::Tick;
 
-use crate::bus::{Bus, BusError};
-use crate::inproc_bus::InprocEndpoint;
+use firmware_host::bus::{Bus, BusError};
+use firmware_host::inproc_bus::InprocEndpoint;
 use std::time::Duration;
 
 /// The firmware node and its bus endpoint.

@@ -3,18 +3,16 @@
 //! E2E checks and a command timeout.
 //!
 //! - [`physics`]: the model and its state (ground truth);
-//! - [`bus`], [`inproc_bus`], [`socketcan_bus`]: one bus abstraction, two implementations;
+//! - the buses come from `firmware_host` (one abstraction, in-process and SocketCAN);
 //! - [`leg_drive`], [`wheel_drive`], [`imu`], [`hardware`]: the emulated nodes;
 //! - [`lockstep`], [`realtime`]: the two clocks;
 //! - [`telemetry`], [`telemetry_csv`], [`candump`], [`plots`]: what a user looks at.
 
-pub mod bus;
 pub mod candump;
 pub mod drive_core;
 pub mod error_chain;
 pub mod hardware;
 pub mod imu;
-pub mod inproc_bus;
 pub mod inproc_controller;
 pub mod leg_drive;
 pub mod lockstep;
@@ -32,7 +30,6 @@ pub mod scenario;
 pub mod scripted_teleop;
 pub mod session;
 pub mod simulator;
-pub mod socketcan_bus;
 pub mod summary;
 pub mod telemetry;
 pub mod telemetry_csv;

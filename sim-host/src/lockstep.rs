@@ -1,6 +1,6 @@
-//! Lockstep: the simulator is the clock. Each cycle it sends SYNC and the nodes' feedback, waits
-//! for the controller's wheel command (the frame a controller sends every cycle, after its leg
-//! targets), then steps. Deterministic, and as fast as the two sides can go.
+//! Lockstep: the simulator is the clock. Each cycle it sends the nodes' feedback and then SYNC,
+//! waits for the controller's wheel command (the frame a controller sends every cycle, after its
+//! leg targets), then steps. Deterministic, and as fast as the two sides can go.
 //!
 //! A command that does not arrive within the reply timeout counts as a missed cycle; the drives
 //! then act on their previous commands (and time out after 100 ms, as real drives do).
@@ -9,10 +9,10 @@ use std::time::{Duration, Instant};
 
 use protocol::MessageId;
 
-use crate::bus::Bus;
 use crate::recorder::Recorder;
 use crate::run_stats::{RunError, RunStats};
 use crate::simulator::Simulator;
+use firmware_host::bus::Bus;
 
 /// Lockstep settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -39,8 +39,10 @@ pub fn run(
     let mut stats = RunStats::default();
     for _ in 0..options.cycles {
         let time_s = sim.time_s();
-        let mut outgoing = vec![sim.sync_frame()?];
-        outgoing.extend(sim.frames_due()?);
+        // Feedback first, then SYNC: a controller in another process computes the tick when
+        // SYNC arrives, with this cycle's feedback already in hand.
+        let mut outgoing = sim.frames_due()?;
+        outgoing.push(sim.sync_frame()?);
         for frame in &outgoing {
             bus.send(frame)?;
             recorder.frame(time_s, frame)?;

@@ -5,10 +5,10 @@
 
 use std::time::{Duration, Instant};
 
-use crate::bus::Bus;
 use crate::recorder::Recorder;
 use crate::run_stats::{RunError, RunStats};
 use crate::simulator::Simulator;
+use firmware_host::bus::Bus;
 
 /// Real-time settings.
 #[derive(Debug, Clone, Copy, PartialEq)]

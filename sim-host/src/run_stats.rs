@@ -2,8 +2,8 @@
 
 use std::time::Duration;
 
-use crate::bus::BusError;
 use crate::output_error::OutputError;
+use firmware_host::bus::BusError;
 
 /// Counters of one run.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

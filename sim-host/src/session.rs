@@ -12,9 +12,7 @@ use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
 
-use crate::bus::{Bus, BusError};
 use crate::imu::ImuNoise;
-use crate::inproc_bus::InprocBus;
 use crate::inproc_controller::InprocController;
 use crate::lockstep::{self, LockstepOptions};
 use crate::metrics::{BusCounters, SegmentSummary, SegmentTracker};
@@ -25,8 +23,10 @@ use crate::recorder::Recorder;
 use crate::run_stats::{RunError, RunStats};
 use crate::scripted_teleop::{PlanStep, ScriptedTeleop};
 use crate::simulator::{Simulator, StartPose};
-use crate::socketcan_bus::SocketCanBus;
 use crate::telemetry::TelemetryRow;
+use firmware_host::bus::{Bus, BusError};
+use firmware_host::inproc_bus::InprocBus;
+use firmware_host::socketcan_bus::SocketCanBus;
 
 /// Which bus the simulator joins.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -7,13 +7,13 @@ use std::path::Path;
 use std::rc::Rc;
 use std::time::Duration;
 
+use firmware_host::bus::Bus;
+use firmware_host::inproc_bus::{InprocBus, InprocEndpoint};
 use protocol::{
     Angle, AnyMessage, DriveEnable, DriveFlags, DriveStatus, E2eCounter, EStop, EStopAction, Frame,
     Leg, LegFeedback, LegTargets, NodeId, Receiver, Torque, WheelCommand, WheelFeedback,
 };
-use sim_host::bus::Bus;
 use sim_host::imu::ImuNoise;
-use sim_host::inproc_bus::{InprocBus, InprocEndpoint};
 use sim_host::lockstep::{self, LockstepOptions};
 use sim_host::model::DEFAULT_MODEL;
 use sim_host::recorder::Recorder;

@@ -1,0 +1,96 @@
+//! `firmware-host`: the robot's firmware (the same control core as the MCU image) as a host
+//! process on a SocketCAN interface.
+
+use std::process::ExitCode;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use clap::{Parser, ValueEnum};
+use firmware_host::runner::{self, Clock, RunnerConfig};
+use firmware_host::socketcan_bus::SocketCanBus;
+
+/// The hybrid robot's firmware as a host process on a CAN interface.
+///
+/// In lockstep mode it computes one control tick per SYNC frame from the simulator
+/// (`sim-host run --bus vcan0`); in timer mode it keeps its own time at the control rate, as on
+/// the microcontroller. Ctrl-C or SIGTERM stops it after sending the drives a stop (legs
+/// torque-free, zero wheel torque).
+///
+/// Example: firmware-host --bus vcan0 --clock lockstep
+#[derive(Debug, Parser)]
+#[command(version, about, long_about)]
+struct Cli {
+    /// The SocketCAN interface (vcan0, can0).
+    #[arg(long, default_value = "vcan0")]
+    bus: String,
+    /// What paces the control loop.
+    #[arg(long, value_enum, default_value = "lockstep")]
+    clock: ClockArg,
+    /// Control rate, Hz (timer mode; in lockstep it sets the firmware's tick length).
+    #[arg(long, default_value_t = 250)]
+    rate_hz: u32,
+    /// Stop after this many control ticks.
+    #[arg(long)]
+    ticks: Option<u64>,
+    /// Lockstep: exit with an error when no SYNC arrives for this many seconds.
+    #[arg(long)]
+    idle_timeout_s: Option<f64>,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum ClockArg {
+    /// One tick per SYNC frame from the simulator.
+    Lockstep,
+    /// The wall clock at --rate-hz.
+    Timer,
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
+    let cli = Cli::parse();
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        tracing::warn!("Ctrl-C/SIGTERM will not stop the drives first: {e}");
+    }
+    let mut bus = match SocketCanBus::open(&cli.bus) {
+        Ok(bus) => bus,
+        Err(e) => {
+            eprintln!("firmware-host: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let config = RunnerConfig {
+        clock: match cli.clock {
+            ClockArg::Lockstep => Clock::Lockstep,
+            ClockArg::Timer => Clock::Timer,
+        },
+        control_hz: cli.rate_hz,
+        max_ticks: cli.ticks,
+        idle_timeout: cli
+            .idle_timeout_s
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .map(Duration::from_secs_f64),
+    };
+    tracing::info!(bus = %cli.bus, clock = ?cli.clock, rate_hz = cli.rate_hz, "firmware running");
+    match runner::run(&mut bus, config, &stop) {
+        Ok(stats) => {
+            println!(
+                "ticks {} | frames in {} out {} | rejected {:?} | overruns {}",
+                stats.ticks, stats.frames_in, stats.frames_out, stats.rejected, stats.overruns
+            );
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("firmware-host: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}

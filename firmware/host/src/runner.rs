@@ -1,0 +1,195 @@
+//! The firmware's control core as a CAN node in a host process: frames in through a
+//! [`Bus`], the [`Node`] decides, frames out. Two clocks:
+//!
+//! - **lockstep**: the simulator sends each cycle's feedback and then `SYNC(tick)`; on `SYNC`
+//!   the runner computes that tick and answers with its commands. Nothing else paces it.
+//! - **timer**: the runner keeps its own time at the control rate, as on the MCU, taking
+//!   whatever arrived since the last tick.
+//!
+//! On a stop request (SIGINT/SIGTERM in the binary) it sends the drives a last command — zero
+//! wheel torque, legs torque-free — rather than leave them to time out.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use firmware::config::Config;
+use firmware::node::Node;
+use firmware::time::{Tick, TickRate};
+use protocol::{decode_frame, AnyMessage, MessageId};
+
+use crate::bus::{Bus, BusError};
+
+/// How the runner keeps time.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Clock {
+    /// Compute one tick per `SYNC` frame.
+    Lockstep,
+    /// Compute on the wall clock at the control rate.
+    Timer,
+}
+
+/// Runner settings.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RunnerConfig {
+    /// Clock.
+    pub clock: Clock,
+    /// Control rate, Hz.
+    pub control_hz: u32,
+    /// Stop after this many control ticks (`None`: until asked to stop).
+    pub max_ticks: Option<u64>,
+    /// Lockstep: give up when no `SYNC` arrives for this long.
+    pub idle_timeout: Option<Duration>,
+}
+
+/// What a run did.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RunnerStats {
+    /// Control ticks computed.
+    pub ticks: u64,
+    /// Frames received.
+    pub frames_in: u64,
+    /// Frames sent.
+    pub frames_out: u64,
+    /// Frames the firmware rejected, by cause (unknown id, wrong length, CRC, out of range,
+    /// repeated, wrong sequence).
+    pub rejected: [u64; 6],
+    /// Timer mode: ticks that started later than one period after their deadline.
+    pub overruns: u64,
+}
+
+/// Why the runner stopped with an error.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RunnerError {
+    /// The control rate is not one the firmware runs at.
+    #[error("the firmware cannot run at {0} Hz (1…10000 Hz)")]
+    Rate(u32),
+    /// The firmware rejected its configuration.
+    #[error("the firmware rejected its configuration: {0:?}")]
+    Config(firmware::controller::ConfigError),
+    /// The bus failed.
+    #[error(transparent)]
+    Bus(#[from] BusError),
+    /// Lockstep: the simulator went quiet.
+    #[error("no SYNC for {0:?}: is the simulator running on this bus in lockstep mode?")]
+    NoSync(Duration),
+}
+
+/// Runs the firmware on `bus` until `stop` is set, `max_ticks` are done, or an error.
+pub fn run(
+    bus: &mut dyn Bus,
+    config: RunnerConfig,
+    stop: &AtomicBool,
+) -> Result<RunnerStats, RunnerError> {
+    let rate = TickRate::new(config.control_hz).ok_or(RunnerError::Rate(config.control_hz))?;
+    let mut node = Node::new(Config::ROBOT.at_rate(rate)).map_err(RunnerError::Config)?;
+    let mut stats = RunnerStats::default();
+    let result = match config.clock {
+        Clock::Lockstep => lockstep(bus, &mut node, config, stop, &mut stats),
+        Clock::Timer => timer(bus, &mut node, rate, config, stop, &mut stats),
+    };
+    stats.rejected = node.reject_counters().rejected.map(|n| u64::from(n.raw()));
+    send_stop(bus, &mut node, &mut stats)?;
+    result.map(|()| stats)
+}
+
+fn done(config: &RunnerConfig, stats: &RunnerStats, stop: &AtomicBool) -> bool {
+    stop.load(Ordering::Relaxed) || config.max_ticks.is_some_and(|n| stats.ticks >= n)
+}
+
+fn lockstep(
+    bus: &mut dyn Bus,
+    node: &mut Node,
+    config: RunnerConfig,
+    stop: &AtomicBool,
+    stats: &mut RunnerStats,
+) -> Result<(), RunnerError> {
+    // Frames before a SYNC belong to the tick it names; until the first, to tick 0.
+    let mut next = Tick(0);
+    let mut last_sync = Instant::now();
+    while !done(&config, stats, stop) {
+        let Some(frame) = bus.recv(Duration::from_millis(50))? else {
+            if let Some(limit) = config.idle_timeout {
+                if last_sync.elapsed() > limit {
+                    return Err(RunnerError::NoSync(limit));
+                }
+            }
+            continue;
+        };
+        stats.frames_in += 1;
+        if node.on_frame(next, frame.id(), frame.data()).is_err() {
+            continue;
+        }
+        if frame.id() != MessageId::Sync.raw() {
+            continue;
+        }
+        let Ok(decoded) = decode_frame(frame.id(), frame.data()) else {
+            continue;
+        };
+        let AnyMessage::Sync(sync) = decoded.message else {
+            continue;
+        };
+        last_sync = Instant::now();
+        let tick = Tick(sync.tick.raw());
+        let (_, frames) = node.poll(tick);
+        for out in &frames {
+            bus.send(out)?;
+            stats.frames_out += 1;
+        }
+        stats.ticks += 1;
+        next = tick.plus(1);
+    }
+    Ok(())
+}
+
+fn timer(
+    bus: &mut dyn Bus,
+    node: &mut Node,
+    rate: TickRate,
+    config: RunnerConfig,
+    stop: &AtomicBool,
+    stats: &mut RunnerStats,
+) -> Result<(), RunnerError> {
+    let period = Duration::from_nanos(1_000_000_000 / u64::from(rate.hz()));
+    let start = Instant::now();
+    let mut tick = Tick(0);
+    while !done(&config, stats, stop) {
+        while let Some(frame) = bus.recv(Duration::ZERO)? {
+            stats.frames_in += 1;
+            let _ = node.on_frame(tick, frame.id(), frame.data());
+        }
+        let (_, frames) = node.poll(tick);
+        for out in &frames {
+            bus.send(out)?;
+            stats.frames_out += 1;
+        }
+        stats.ticks += 1;
+        tick = tick.plus(1);
+        let deadline = start + period * u32::try_from(stats.ticks).unwrap_or(u32::MAX);
+        let now = Instant::now();
+        if now > deadline + period {
+            stats.overruns += 1;
+        }
+        // Wait for the next tick, taking frames as they come so that they are timely.
+        while let Some(left) = deadline.checked_duration_since(Instant::now()) {
+            if left.is_zero() {
+                break;
+            }
+            if let Some(frame) = bus.recv(left)? {
+                stats.frames_in += 1;
+                let _ = node.on_frame(tick, frame.id(), frame.data());
+            }
+        }
+    }
+    Ok(())
+}
+
+/// Zero wheel torque and torque-free legs, in sequence with the node's commands, so that the
+/// drives stop now instead of after their 100 ms timeout.
+fn send_stop(bus: &mut dyn Bus, node: &mut Node, stats: &mut RunnerStats) -> Result<(), BusError> {
+    for frame in &node.stop_frames() {
+        bus.send(frame)?;
+        stats.frames_out += 1;
+    }
+    Ok(())
+}

@@ -1,0 +1,115 @@
+//! The runner answers SYNC with the firmware's commands, keeps time in timer mode, and stops
+//! the drives when it stops.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use firmware_host::bus::Bus;
+use firmware_host::inproc_bus::InprocBus;
+use firmware_host::runner::{self, Clock, RunnerConfig};
+use protocol::{AnyMessage, DriveEnable, E2eCounter, MessageId, Receiver, Sync, Tick};
+
+fn sync(tick: u32, counter: &mut E2eCounter) -> protocol::Frame {
+    AnyMessage::Sync(Sync {
+        tick: Tick::from_raw(tick).unwrap(),
+    })
+    .encode(counter.advance())
+    .unwrap()
+}
+
+#[test]
+fn lockstep_answers_every_sync_with_a_wheel_command_then_stops_the_drives() {
+    let bus = InprocBus::new();
+    let mut sim = bus.endpoint();
+    let mut firmware_bus = bus.endpoint();
+    let stop = Arc::new(AtomicBool::new(false));
+    let runner_stop = Arc::clone(&stop);
+    let runner = std::thread::spawn(move || {
+        runner::run(
+            &mut firmware_bus,
+            RunnerConfig {
+                clock: Clock::Lockstep,
+                control_hz: 250,
+                max_ticks: Some(50),
+                idle_timeout: Some(Duration::from_secs(10)),
+            },
+            &runner_stop,
+        )
+    });
+    let mut counter = E2eCounter::default();
+    let mut rx = Receiver::default();
+    let mut commands = 0;
+    for tick in 0..50 {
+        sim.send(&sync(tick, &mut counter)).unwrap();
+        // Each SYNC is answered with a wheel command before the next one is sent.
+        loop {
+            let frame = sim
+                .recv(Duration::from_secs(5))
+                .unwrap()
+                .expect("an answer");
+            let message = rx.receive(frame.id(), frame.data()).unwrap().message;
+            if frame.id() == MessageId::WheelCommand.raw() {
+                commands += 1;
+                break;
+            }
+            let _ = message;
+        }
+    }
+    let stats = runner.join().unwrap().unwrap();
+    assert_eq!((commands, stats.ticks), (50, 50));
+    assert_eq!(stats.rejected, [0; 6]);
+    // The last frames: legs torque-free and zero wheel torque, accepted in sequence.
+    let mut last_legs = None;
+    while let Some(frame) = sim.recv(Duration::from_millis(100)).unwrap() {
+        let accepted = rx.receive(frame.id(), frame.data()).expect("in sequence");
+        if let AnyMessage::LegTargets(targets) = accepted.message {
+            last_legs = Some(targets.enable);
+        }
+    }
+    assert_eq!(last_legs, Some(DriveEnable::Disabled));
+    assert!(!stop.load(Ordering::Relaxed));
+}
+
+#[test]
+fn a_quiet_bus_in_lockstep_is_an_error_naming_the_simulator() {
+    let bus = InprocBus::new();
+    let mut firmware_bus = bus.endpoint();
+    let err = runner::run(
+        &mut firmware_bus,
+        RunnerConfig {
+            clock: Clock::Lockstep,
+            control_hz: 250,
+            max_ticks: None,
+            idle_timeout: Some(Duration::from_millis(200)),
+        },
+        &AtomicBool::new(false),
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("simulator"), "{err}");
+}
+
+#[test]
+fn timer_mode_keeps_its_own_time() {
+    let bus = InprocBus::new();
+    let mut listener = bus.endpoint();
+    let mut firmware_bus = bus.endpoint();
+    let stats = runner::run(
+        &mut firmware_bus,
+        RunnerConfig {
+            clock: Clock::Timer,
+            control_hz: 250,
+            max_ticks: Some(25),
+            idle_timeout: None,
+        },
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    assert_eq!(stats.ticks, 25);
+    let mut wheel_commands = 0;
+    while let Some(frame) = listener.recv(Duration::ZERO).unwrap() {
+        wheel_commands += usize::from(frame.id() == MessageId::WheelCommand.raw());
+    }
+    // One per tick, plus the stop.
+    assert_eq!(wheel_commands, 26);
+}
