@@ -105,6 +105,9 @@ struct RunArgs {
     /// Skip the PNG plots.
     #[arg(long)]
     no_plots: bool,
+    /// No progress bar (for logs and scripts).
+    #[arg(long)]
+    no_progress: bool,
     /// Open the interactive MuJoCo viewer, synced every control cycle; it stays open after the
     /// run until closed, and closing it early ends the run. Needs a display; best with
     /// `--mode realtime` (lockstep plays faster than real time). Build with `--features viewer`.
@@ -247,7 +250,7 @@ fn run(args: RunArgs) -> Result<(), String> {
         teleop_plan,
         out_dir: Some(args.out.clone()),
         plots: !args.no_plots,
-        progress: true,
+        progress: !args.no_progress,
         frames: args.render_every.map(|every_cycles| FrameSettings {
             dir: args.out.join("frames"),
             every_cycles,

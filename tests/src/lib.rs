@@ -1,4 +1,224 @@
 //! Hardware-in-the-loop suite over SocketCAN `vcan`.
 //!
-//! The firmware and the simulator run as separate processes that share nothing but a kernel CAN
-//! interface. The scenarios land with the vcan issue; this crate holds them.
+//! The firmware (`firmware-host`) and the simulator (`sim-host`) run as separate processes
+//! that share nothing but a kernel CAN interface. Each test makes its own `vcan` interface, so
+//! tests run in parallel and never touch a real `can0`. It needs root (or CAP_NET_ADMIN) and the
+//! kernel's `vcan` module: `cargo xtask hil` runs it natively where that is so, and otherwise
+//! in a QEMU VM with a stock Debian kernel. Without them a test fails and says what is missing.
+//!
+//! Binaries come from `HIL_BIN_DIR` (default: the workspace's `target/release`).
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::atomic::{AtomicU32, Ordering};
+use std::time::{Duration, Instant};
+
+/// The workspace root.
+pub fn workspace() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default()
+}
+
+/// A program of this project or of can-utils: from `HIL_BIN_DIR`, else `target/release`, else
+/// the `PATH` (can-utils).
+pub fn program(name: &str) -> PathBuf {
+    let dir = std::env::var_os("HIL_BIN_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| workspace().join("target").join("release"));
+    let local = dir.join(name);
+    if local.exists() {
+        local
+    } else {
+        PathBuf::from(name)
+    }
+}
+
+/// A `vcan` interface of this test, removed when dropped.
+#[derive(Debug)]
+pub struct Vcan {
+    name: String,
+}
+
+static NEXT: AtomicU32 = AtomicU32::new(0);
+
+impl Vcan {
+    /// Creates `vcanhil<pid>_<n>` (CAN FD MTU, up). Panics with what to do when it cannot.
+    pub fn new() -> Self {
+        let name = format!(
+            "vh{}_{}",
+            std::process::id() % 100_000,
+            NEXT.fetch_add(1, Ordering::Relaxed)
+        );
+        let ip = |args: &[&str]| {
+            Command::new("ip")
+                .args(args)
+                .output()
+                .map_err(|e| format!("cannot run `ip` (iproute2): {e}"))
+                .and_then(|out| {
+                    if out.status.success() {
+                        Ok(())
+                    } else {
+                        Err(String::from_utf8_lossy(&out.stderr).trim().to_owned())
+                    }
+                })
+        };
+        if let Err(e) = ip(&["link", "add", "dev", &name, "type", "vcan"]) {
+            panic!(
+                "cannot create a vcan interface ({e}). This suite needs root (or CAP_NET_ADMIN) and \
+                 the kernel's vcan module (`sudo modprobe vcan`); `cargo xtask hil` runs it in a \
+                 QEMU VM where the host has neither."
+            );
+        }
+        for args in [
+            vec!["link", "set", "dev", name.as_str(), "mtu", "72"],
+            vec!["link", "set", "dev", name.as_str(), "up"],
+        ] {
+            if let Err(e) = ip(&args) {
+                panic!("cannot set up {name}: {e}");
+            }
+        }
+        Self { name }
+    }
+
+    /// The interface name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+}
+
+impl Default for Vcan {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Drop for Vcan {
+    fn drop(&mut self) {
+        let _ = Command::new("ip")
+            .args(["link", "del", "dev", &self.name])
+            .status();
+    }
+}
+
+/// A child process killed (SIGTERM, then SIGKILL) when dropped.
+#[derive(Debug)]
+pub struct Process {
+    child: Child,
+    name: String,
+}
+
+impl Process {
+    /// Starts `program` with `args`, its output to this test's output.
+    pub fn start(program_name: &str, args: &[&str]) -> Self {
+        let child = Command::new(program(program_name))
+            .args(args)
+            .stdout(Stdio::inherit())
+            .stderr(Stdio::inherit())
+            .spawn()
+            .unwrap_or_else(|e| panic!("cannot start {program_name}: {e} (build it: cargo build --release -p {program_name})"));
+        Self {
+            child,
+            name: program_name.to_owned(),
+        }
+    }
+
+    /// Waits for the process to exit by itself, at most `timeout`; its exit status.
+    pub fn wait(mut self, timeout: Duration) -> std::process::ExitStatus {
+        let started = Instant::now();
+        loop {
+            if let Ok(Some(status)) = self.child.try_wait() {
+                return status;
+            }
+            if started.elapsed() > timeout {
+                panic!("{} did not finish within {timeout:?}", self.name);
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    /// Asks the process to stop (SIGTERM) and waits for it.
+    pub fn terminate(mut self) -> std::process::ExitStatus {
+        let _ = Command::new("kill")
+            .args(["-TERM", &self.child.id().to_string()])
+            .status();
+        let started = Instant::now();
+        loop {
+            if let Ok(Some(status)) = self.child.try_wait() {
+                return status;
+            }
+            if started.elapsed() > Duration::from_secs(5) {
+                let _ = self.child.kill();
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+}
+
+impl Drop for Process {
+    fn drop(&mut self) {
+        if let Ok(None) = self.child.try_wait() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
+}
+
+/// A fresh output folder for a test.
+pub fn out_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("hil-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+/// The firmware in lockstep on `bus`.
+pub fn firmware(bus: &Vcan) -> Process {
+    Process::start(
+        "firmware-host",
+        &[
+            "--bus",
+            bus.name(),
+            "--clock",
+            "lockstep",
+            "--idle-timeout-s",
+            "20",
+        ],
+    )
+}
+
+/// Runs `sim-host run` on `bus` with `args`; returns the parsed `summary.json` if it wrote one.
+pub fn simulate(bus: &Vcan, out: &Path, args: &[&str]) -> Option<serde_json::Value> {
+    let out_text = out.to_string_lossy().into_owned();
+    let mut all = vec![
+        "run",
+        "--bus",
+        bus.name(),
+        "--no-plots",
+        "--no-progress",
+        "--out",
+        &out_text,
+    ];
+    all.extend_from_slice(args);
+    let status = Process::start("sim-host", &all).wait(Duration::from_secs(600));
+    assert!(status.success(), "sim-host failed: {status}");
+    std::fs::read_to_string(out.join("summary.json"))
+        .ok()
+        .and_then(|text| serde_json::from_str(&text).ok())
+}
+
+/// A number of segment `index` of a summary.
+pub fn figure(summary: &serde_json::Value, index: usize, key: &str) -> f64 {
+    summary["segments"][index][key]
+        .as_f64()
+        .unwrap_or_else(|| panic!("summary has no segments[{index}].{key}: {summary}"))
+}
+
+/// An acceptance scenario file.
+pub fn scenario(name: &str) -> String {
+    workspace()
+        .join("scenarios/acceptance")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}

@@ -5,6 +5,7 @@ mod bench;
 mod busload;
 mod dbc;
 mod demo;
+mod hil;
 mod mujoco;
 mod setup;
 mod test;
@@ -27,6 +28,9 @@ Tasks:
   bench [args]       criterion benchmarks (control step, raw MuJoCo step, closed-loop cycle), then a
                      table of medians and steps per second
                      (args go to criterion, e.g. `--measurement-time 3`)
+  hil [--vm]         the vcan hardware-in-the-loop suite: firmware and simulator as two processes
+                     on a kernel vcan; natively where this kernel has vcan and you are root,
+                     otherwise (or with --vm) in a QEMU VM booting a stock Debian kernel
   demo [options]     the report's demonstration, closed loop (STOP, W, S, A, L, K, X): sets up,
                      builds, runs scenarios/report_demo.toml with the firmware on the in-process
                      CAN bus; writes out/ (summary.json, telemetry.csv, bus.log, plots, frames)
@@ -50,6 +54,7 @@ fn main() -> ExitCode {
         "busload" => busload::run(),
         "bench" => bench::run_task(rest),
         "demo" => demo::run(rest),
+        "hil" => hil::run(rest),
         "help" | "-h" | "--help" => {
             print!("{HELP}");
             Ok(())

@@ -1,0 +1,49 @@
+//! The closed-loop acceptance scenarios with the firmware and the simulator as two processes on
+//! one vcan interface, asserting the same figures as the in-process tests.
+
+use hil_tests::{figure, firmware, out_dir, scenario, simulate, Vcan};
+
+#[test]
+fn w_over_vcan_drives_1_4_m_in_4_s_on_its_wheels() {
+    let bus = Vcan::new();
+    let fw = firmware(&bus);
+    let out = out_dir("w");
+    let summary = simulate(&bus, &out, &["--scenario", &scenario("w.toml")]).expect("summary");
+    let _ = fw.terminate();
+    let forward = figure(&summary, 1, "forward_m");
+    let tilt = figure(&summary, 1, "max_tilt_deg");
+    println!("W over vcan: {forward:.3} m, tilt {tilt:.1}°");
+    assert!(forward >= 1.4, "{summary}");
+    assert!(figure(&summary, 1, "lateral_m").abs() <= 0.15);
+    assert!(tilt <= 10.0);
+    assert_eq!(figure(&summary, 1, "feet_or_body_on_ground_cycles"), 0.0);
+    assert_eq!(summary["missed_cycles"].as_u64(), Some(0), "{summary}");
+}
+
+#[test]
+fn a_over_vcan_turns_180_degrees_in_2_s() {
+    let bus = Vcan::new();
+    let fw = firmware(&bus);
+    let out = out_dir("a");
+    let summary = simulate(&bus, &out, &["--scenario", &scenario("a.toml")]).expect("summary");
+    let _ = fw.terminate();
+    let yaw = figure(&summary, 1, "dyaw_deg");
+    let moved = figure(&summary, 1, "dx_m").hypot(figure(&summary, 1, "dy_m"));
+    println!("A over vcan: {yaw:.1}°, centre {moved:.3} m");
+    assert!(yaw.abs() >= 180.0 && moved <= 0.10, "{summary}");
+}
+
+#[test]
+fn l_over_vcan_trots_0_4_m_in_8_s() {
+    let bus = Vcan::new();
+    let fw = firmware(&bus);
+    let out = out_dir("l");
+    let summary = simulate(&bus, &out, &["--scenario", &scenario("l.toml")]).expect("summary");
+    let _ = fw.terminate();
+    let forward = figure(&summary, 1, "forward_m");
+    println!("L over vcan: {forward:.3} m");
+    assert!(forward >= 0.4, "{summary}");
+    assert!(figure(&summary, 1, "max_roll_deg") <= 15.0);
+    assert!(figure(&summary, 1, "max_pitch_deg") <= 15.0);
+    assert_eq!(figure(&summary, 1, "torso_on_ground_cycles"), 0.0);
+}

@@ -1,0 +1,301 @@
+//! `cargo xtask hil`: the hardware-in-the-loop suite (`tests/`, package `hil-tests`) — the
+//! firmware and the simulator as two processes on a kernel `vcan` interface.
+//!
+//! Where this machine can make `vcan` interfaces (root or CAP_NET_ADMIN, the `vcan` module),
+//! the suite runs natively. Otherwise it boots a throwaway QEMU VM (`-accel tcg`) with a stock
+//! Debian kernel from apt and an initramfs holding busybox, the kernel's `can`, `can-raw`,
+//! `can-dev` and `vcan` modules (loaded in that order), iproute2, can-utils, the project's
+//! binaries and test binary with their shared libraries (libmujoco too), the models and the
+//! scenarios; runs the suite inside, prints it on the console and exits with its status.
+//! Everything comes from apt and is cached in `.cache/hil/`.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+
+use crate::util::{cargo, output, root, run as sh};
+
+/// What the suite needs from apt.
+const PACKAGES: [&str; 5] = [
+    "qemu-system-x86",
+    "busybox-static",
+    "can-utils",
+    "cpio",
+    "iproute2",
+];
+/// The kernel modules, in load order.
+const MODULES: [&str; 4] = [
+    "net/can/can.ko",
+    "net/can/can-raw.ko",
+    "drivers/net/can/dev/can-dev.ko",
+    "drivers/net/can/vcan.ko",
+];
+/// Programs copied into the VM from the host's PATH.
+const TOOLS: [&str; 4] = ["ip", "candump", "cansend", "canplayer"];
+/// The line the VM prints last: `HIL-EXIT <status>`.
+const EXIT_MARK: &str = "HIL-EXIT ";
+
+pub fn run(args: &[String]) -> Result<(), String> {
+    let force_vm = args.iter().any(|a| a == "--vm");
+    crate::setup::run()?;
+    crate::apt::ensure(&PACKAGES, "the vcan suite (cargo xtask hil)")?;
+    sh(cargo().args([
+        "build",
+        "--release",
+        "-p",
+        "sim-host",
+        "-p",
+        "firmware-host",
+    ]))?;
+    let suite = build_suite()?;
+    if !force_vm && native_vcan() {
+        eprintln!("hil: this kernel has vcan: running natively");
+        return sh(Command::new(&suite)
+            .args(["--test-threads", "2"])
+            .env("HIL_BIN_DIR", root().join("target").join("release")));
+    }
+    eprintln!("hil: no vcan here: running the suite in a QEMU VM");
+    let kernel = kernel()?;
+    let initrd = initramfs(&kernel, &suite)?;
+    boot(&kernel.vmlinuz, &initrd)
+}
+
+/// Builds the suite's test binary in release; its path.
+fn build_suite() -> Result<PathBuf, String> {
+    let out = output(cargo().args([
+        "test",
+        "--release",
+        "-p",
+        "hil-tests",
+        "--no-run",
+        "--message-format=json",
+    ]))
+    .ok_or(
+        "could not build the hil-tests suite (run `cargo test -p hil-tests --no-run` to see why)",
+    )?;
+    out.lines()
+        .filter(|line| line.contains("\"name\":\"vcan\"") && line.contains("\"executable\":\""))
+        .find_map(|line| {
+            let start = line.find("\"executable\":\"")? + "\"executable\":\"".len();
+            let end = start + line.get(start..)?.find('"')?;
+            line.get(start..end).map(PathBuf::from)
+        })
+        .ok_or_else(|| "cargo did not report the vcan test binary".into())
+}
+
+/// Whether this machine can make a vcan interface.
+fn native_vcan() -> bool {
+    let probe = "hilprobe0";
+    let made = Command::new("ip")
+        .args(["link", "add", "dev", probe, "type", "vcan"])
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success());
+    if made {
+        let _ = Command::new("ip")
+            .args(["link", "del", "dev", probe])
+            .status();
+    }
+    made
+}
+
+struct Kernel {
+    vmlinuz: PathBuf,
+    modules: PathBuf,
+}
+
+/// The Debian kernel `linux-image-amd64` depends on, unpacked in `.cache/hil/kernel`.
+fn kernel() -> Result<Kernel, String> {
+    let cache = root().join(".cache").join("hil");
+    let dir = cache.join("kernel");
+    let depends = output(Command::new("apt-cache").args(["depends", "linux-image-amd64"]))
+        .ok_or("`apt-cache depends linux-image-amd64` failed: is this a Debian system with apt?")?;
+    let package = depends
+        .lines()
+        .find_map(|l| l.trim().strip_prefix("Depends: linux-image-"))
+        .map(|rest| format!("linux-image-{rest}"))
+        .ok_or("no linux-image package behind linux-image-amd64")?;
+    let version = package.trim_start_matches("linux-image-");
+    let vmlinuz = dir.join("boot").join(format!("vmlinuz-{version}"));
+    let modules = dir.join("lib").join("modules").join(version).join("kernel");
+    if !vmlinuz.exists() {
+        std::fs::create_dir_all(&cache).map_err(|e| format!("{}: {e}", cache.display()))?;
+        eprintln!("hil: fetching {package} (~70 MB, once)");
+        sh(Command::new("apt-get")
+            .args(["download", "-q", &package])
+            .current_dir(&cache))?;
+        let deb = std::fs::read_dir(&cache)
+            .map_err(|e| e.to_string())?
+            .filter_map(Result::ok)
+            .map(|e| e.path())
+            .find(|p| {
+                p.file_name()
+                    .is_some_and(|n| n.to_string_lossy().starts_with(&format!("{package}_")))
+            })
+            .ok_or("apt-get download left no .deb")?;
+        sh(Command::new("dpkg-deb").arg("-x").arg(&deb).arg(&dir))?;
+        let _ = std::fs::remove_file(&deb);
+    }
+    Ok(Kernel { vmlinuz, modules })
+}
+
+/// Copies `file` to the same path under `root_dir`.
+fn copy_to(root_dir: &Path, file: &Path) -> Result<(), String> {
+    let target = root_dir.join(file.strip_prefix("/").unwrap_or(file));
+    if let Some(parent) = target.parent() {
+        std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
+    }
+    std::fs::copy(file, &target)
+        .map(|_| ())
+        .map_err(|e| format!("copy {}: {e}", file.display()))
+}
+
+/// Copies a program and every shared library `ldd` names for it.
+fn copy_with_libraries(root_dir: &Path, program: &Path) -> Result<(), String> {
+    copy_to(root_dir, program)?;
+    let libraries = output(Command::new("ldd").arg(program)).unwrap_or_default();
+    for word in libraries.split_whitespace().filter(|w| w.starts_with('/')) {
+        let path = PathBuf::from(word);
+        let real = std::fs::canonicalize(&path).unwrap_or(path.clone());
+        copy_to(root_dir, &real)?;
+        if real != path {
+            copy_to(root_dir, &path).or_else(|_| copy_to(root_dir, &real))?;
+            let target = root_dir.join(path.strip_prefix("/").unwrap_or(&path));
+            let _ = std::fs::remove_file(&target);
+            std::fs::copy(&real, &target).map_err(|e| e.to_string())?;
+        }
+    }
+    Ok(())
+}
+
+fn which(name: &str) -> Result<PathBuf, String> {
+    output(Command::new("sh").args(["-c", &format!("command -v {name}")]))
+        .map(|s| PathBuf::from(s.trim()))
+        .filter(|p| p.is_absolute())
+        .ok_or_else(|| format!("`{name}` is not installed"))
+}
+
+fn copy_tree(from: &Path, root_dir: &Path) -> Result<(), String> {
+    for entry in std::fs::read_dir(from).map_err(|e| format!("{}: {e}", from.display()))? {
+        let path = entry.map_err(|e| e.to_string())?.path();
+        if path.is_dir() {
+            copy_tree(&path, root_dir)?;
+        } else {
+            copy_to(root_dir, &path)?;
+        }
+    }
+    Ok(())
+}
+
+/// Builds `.cache/hil/initrd.gz`.
+fn initramfs(kernel: &Kernel, suite: &Path) -> Result<PathBuf, String> {
+    let cache = root().join(".cache").join("hil");
+    let dir = cache.join("root");
+    let _ = std::fs::remove_dir_all(&dir);
+    for sub in ["bin", "proc", "sys", "dev", "tmp", "lib/modules", "run"] {
+        std::fs::create_dir_all(dir.join(sub)).map_err(|e| e.to_string())?;
+    }
+    std::fs::copy(which("busybox")?, dir.join("bin/busybox")).map_err(|e| e.to_string())?;
+    for applet in [
+        "sh", "mount", "insmod", "poweroff", "echo", "cat", "ls", "sleep", "mkdir", "kill", "rm",
+        "env", "uname", "head", "tail", "grep", "date", "true",
+    ] {
+        std::os::unix::fs::symlink("busybox", dir.join("bin").join(applet))
+            .map_err(|e| e.to_string())?;
+    }
+    for module in MODULES {
+        let from = kernel.modules.join(module);
+        let name = Path::new(module).file_name().ok_or("module name")?;
+        std::fs::copy(&from, dir.join("lib/modules").join(name))
+            .map_err(|e| format!("{}: {e}", from.display()))?;
+    }
+    for tool in TOOLS {
+        copy_with_libraries(&dir, &which(tool)?)?;
+    }
+    let release = root().join("target").join("release");
+    for program in ["sim-host", "firmware-host"] {
+        copy_with_libraries(&dir, &release.join(program))?;
+    }
+    copy_with_libraries(&dir, suite)?;
+    copy_tree(&root().join("sim-host").join("models"), &dir)?;
+    copy_tree(&root().join("scenarios"), &dir)?;
+    let tool_dirs: Vec<String> = TOOLS
+        .iter()
+        .filter_map(|t| which(t).ok())
+        .filter_map(|p| p.parent().map(|d| d.display().to_string()))
+        .collect();
+    let modules = MODULES
+        .iter()
+        .filter_map(|m| Path::new(m).file_name())
+        .map(|n| format!("/lib/modules/{}", n.to_string_lossy()))
+        .collect::<Vec<_>>()
+        .join(" ");
+    let init = format!(
+        "#!/bin/sh\n\
+         export PATH=/bin:{tools}\n\
+         mount -t proc proc /proc; mount -t sysfs sys /sys; mount -t devtmpfs dev /dev\n\
+         mount -t tmpfs tmp /tmp\n\
+         for m in {modules}; do insmod $m || echo \"hil: insmod $m failed\"; done\n\
+         echo \"hil: kernel $(uname -r), $(grep -c processor /proc/cpuinfo) CPUs\"\n\
+         HIL_BIN_DIR={release} {suite} --test-threads 2\n\
+         echo \"{mark}$?\"\n\
+         poweroff -f\n",
+        tools = tool_dirs.join(":"),
+        release = release.display(),
+        suite = suite.display(),
+        mark = EXIT_MARK,
+    );
+    let init_path = dir.join("init");
+    std::fs::write(&init_path, init).map_err(|e| e.to_string())?;
+    sh(Command::new("chmod").arg("+x").arg(&init_path))?;
+    let initrd = cache.join("initrd.gz");
+    sh(Command::new("sh").args([
+        "-c",
+        &format!(
+            "cd '{}' && find . | cpio -o -H newc --quiet | gzip -1 > '{}'",
+            dir.display(),
+            initrd.display()
+        ),
+    ]))?;
+    Ok(initrd)
+}
+
+/// Boots the VM, streams its console, returns the suite's status.
+fn boot(vmlinuz: &Path, initrd: &Path) -> Result<(), String> {
+    let mut child = Command::new("qemu-system-x86_64")
+        // `-cpu max`: libmujoco uses AVX, which the default qemu64 model lacks (SIGILL).
+        .args([
+            "-accel", "tcg", "-cpu", "max", "-m", "3072", "-smp", "2", "-kernel",
+        ])
+        .arg(vmlinuz)
+        .arg("-initrd")
+        .arg(initrd)
+        .args([
+            "-append",
+            "console=ttyS0 quiet panic=-1",
+            "-nographic",
+            "-no-reboot",
+        ])
+        .stdout(Stdio::piped())
+        .stdin(Stdio::null())
+        .spawn()
+        .map_err(|e| {
+            format!("cannot start qemu-system-x86_64: {e} (apt-get install qemu-system-x86)")
+        })?;
+    let stdout = child.stdout.take().ok_or("no console")?;
+    let mut status = None;
+    for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+        println!("{line}");
+        if let Some(code) = line.trim().strip_prefix(EXIT_MARK) {
+            status = code.trim().parse::<i32>().ok();
+        }
+    }
+    let _ = child.wait();
+    match status {
+        Some(0) => Ok(()),
+        Some(code) => Err(format!("the vcan suite failed in the VM (exit {code})")),
+        None => {
+            Err("the VM ended without reporting the suite's result (see its console above)".into())
+        }
+    }
+}
