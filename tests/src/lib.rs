@@ -222,3 +222,110 @@ pub fn scenario(name: &str) -> String {
         .to_string_lossy()
         .into_owned()
 }
+
+/// A frame in `cansend`'s notation: `ID##<flags><hex>` (CAN FD, bit-rate switch flag set).
+pub fn cansend_text(frame: &protocol::Frame) -> String {
+    let mut text = format!("{:03X}##1", frame.id());
+    for byte in frame.data() {
+        text.push_str(&format!("{byte:02X}"));
+    }
+    text
+}
+
+/// Sends `frame` with can-utils' `cansend`.
+pub fn cansend(bus: &Vcan, frame: &protocol::Frame) {
+    let status = Command::new(program("cansend"))
+        .args([bus.name(), &cansend_text(frame)])
+        .status()
+        .unwrap_or_else(|e| panic!("cannot run cansend (can-utils): {e}"));
+    assert!(status.success(), "cansend failed: {status}");
+}
+
+/// Starts `candump -L <bus>` writing to `path`.
+pub fn candump(bus: &Vcan, path: &Path) -> Process {
+    let file = std::fs::File::create(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let child = Command::new(program("candump"))
+        .args(["-L", bus.name()])
+        .stdout(file)
+        .spawn()
+        .unwrap_or_else(|e| panic!("cannot run candump (can-utils): {e}"));
+    Process::from_child(child, "candump")
+}
+
+impl Process {
+    /// Wraps a started child.
+    pub fn from_child(child: Child, name: &str) -> Self {
+        Self {
+            child,
+            name: name.to_owned(),
+        }
+    }
+}
+
+/// The frames of a `candump -L` log: `(time s, frame)`; a complete line that is not a CAN FD
+/// frame of this project's form panics with the line.
+pub fn read_candump(path: &Path) -> Vec<(f64, protocol::Frame)> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    // A log still being written may end in half a line: only complete lines count.
+    let complete = text.rfind('\n').map_or("", |end| &text[..end]);
+    complete
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|line| {
+            let mut parts = line.split_whitespace();
+            let time = parts
+                .next()
+                .and_then(|t| t.trim_matches(|c| c == '(' || c == ')').parse::<f64>().ok())
+                .unwrap_or_else(|| panic!("no time in `{line}`"));
+            let frame = parts
+                .nth(1)
+                .unwrap_or_else(|| panic!("no frame in `{line}`"));
+            let (id, rest) = frame
+                .split_once("##")
+                .unwrap_or_else(|| panic!("not a CAN FD frame: `{line}`"));
+            let id = u16::from_str_radix(id, 16).unwrap_or_else(|_| panic!("bad id in `{line}`"));
+            let hex = rest.get(1..).unwrap_or("");
+            let data: Vec<u8> = (0..hex.len() / 2)
+                .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap_or(0))
+                .collect();
+            let frame = protocol::Frame::new(id, &data)
+                .unwrap_or_else(|| panic!("not a valid CAN FD frame: `{line}`"));
+            (time, frame)
+        })
+        .collect()
+}
+
+/// The rows of a `telemetry.csv` as `(time s, wheel torques N·m, mode)`.
+pub fn read_telemetry(path: &Path) -> Vec<(f64, [f64; 2], String)> {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap_or("").split(',').collect();
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|h| *h == name)
+            .unwrap_or_else(|| panic!("no column {name}"))
+    };
+    let (t, left, right, mode) = (
+        col("time_s"),
+        col("wheel_left_torque_nm"),
+        col("wheel_right_torque_nm"),
+        col("mode"),
+    );
+    lines
+        .map(|line| {
+            let cells: Vec<&str> = line.split(',').collect();
+            let num = |i: usize| {
+                cells
+                    .get(i)
+                    .and_then(|c| c.parse::<f64>().ok())
+                    .unwrap_or(f64::NAN)
+            };
+            (
+                num(t),
+                [num(left), num(right)],
+                cells.get(mode).copied().unwrap_or("").to_owned(),
+            )
+        })
+        .collect()
+}

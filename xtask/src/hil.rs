@@ -50,9 +50,12 @@ pub fn run(args: &[String]) -> Result<(), String> {
     let suite = build_suite()?;
     if !force_vm && native_vcan() {
         eprintln!("hil: this kernel has vcan: running natively");
-        return sh(Command::new(&suite)
-            .args(["--test-threads", "2"])
-            .env("HIL_BIN_DIR", root().join("target").join("release")));
+        for binary in &suite {
+            sh(Command::new(binary)
+                .args(["--test-threads", "2"])
+                .env("HIL_BIN_DIR", root().join("target").join("release")))?;
+        }
+        return Ok(());
     }
     eprintln!("hil: no vcan here: running the suite in a QEMU VM");
     let kernel = kernel()?;
@@ -60,8 +63,8 @@ pub fn run(args: &[String]) -> Result<(), String> {
     boot(&kernel.vmlinuz, &initrd)
 }
 
-/// Builds the suite's test binary in release; its path.
-fn build_suite() -> Result<PathBuf, String> {
+/// Builds the suite's test binaries in release; their paths.
+fn build_suite() -> Result<Vec<PathBuf>, String> {
     let out = output(cargo().args([
         "test",
         "--release",
@@ -73,14 +76,20 @@ fn build_suite() -> Result<PathBuf, String> {
     .ok_or(
         "could not build the hil-tests suite (run `cargo test -p hil-tests --no-run` to see why)",
     )?;
-    out.lines()
-        .filter(|line| line.contains("\"name\":\"vcan\"") && line.contains("\"executable\":\""))
-        .find_map(|line| {
+    let suites: Vec<PathBuf> = out
+        .lines()
+        .filter(|line| line.contains("\"kind\":[\"test\"]") && line.contains("\"executable\":\""))
+        .filter_map(|line| {
             let start = line.find("\"executable\":\"")? + "\"executable\":\"".len();
             let end = start + line.get(start..)?.find('"')?;
             line.get(start..end).map(PathBuf::from)
         })
-        .ok_or_else(|| "cargo did not report the vcan test binary".into())
+        .collect();
+    if suites.is_empty() {
+        Err("cargo did not report the hil-tests test binaries".into())
+    } else {
+        Ok(suites)
+    }
 }
 
 /// Whether this machine can make a vcan interface.
@@ -188,7 +197,7 @@ fn copy_tree(from: &Path, root_dir: &Path) -> Result<(), String> {
 }
 
 /// Builds `.cache/hil/initrd.gz`.
-fn initramfs(kernel: &Kernel, suite: &Path) -> Result<PathBuf, String> {
+fn initramfs(kernel: &Kernel, suite: &[PathBuf]) -> Result<PathBuf, String> {
     let cache = root().join(".cache").join("hil");
     let dir = cache.join("root");
     let _ = std::fs::remove_dir_all(&dir);
@@ -216,7 +225,9 @@ fn initramfs(kernel: &Kernel, suite: &Path) -> Result<PathBuf, String> {
     for program in ["sim-host", "firmware-host"] {
         copy_with_libraries(&dir, &release.join(program))?;
     }
-    copy_with_libraries(&dir, suite)?;
+    for binary in suite {
+        copy_with_libraries(&dir, binary)?;
+    }
     copy_tree(&root().join("sim-host").join("models"), &dir)?;
     copy_tree(&root().join("scenarios"), &dir)?;
     let tool_dirs: Vec<String> = TOOLS
@@ -237,12 +248,17 @@ fn initramfs(kernel: &Kernel, suite: &Path) -> Result<PathBuf, String> {
          mount -t tmpfs tmp /tmp\n\
          for m in {modules}; do insmod $m || echo \"hil: insmod $m failed\"; done\n\
          echo \"hil: kernel $(uname -r), $(grep -c processor /proc/cpuinfo) CPUs\"\n\
-         HIL_BIN_DIR={release} {suite} --test-threads 2\n\
-         echo \"{mark}$?\"\n\
+         status=0\n\
+         for suite in {suite}; do HIL_BIN_DIR={release} $suite --test-threads 2 || status=1; done\n\
+         echo \"{mark}$status\"\n\
          poweroff -f\n",
         tools = tool_dirs.join(":"),
         release = release.display(),
-        suite = suite.display(),
+        suite = suite
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(" "),
         mark = EXIT_MARK,
     );
     let init_path = dir.join("init");

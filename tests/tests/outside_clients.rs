@@ -1,0 +1,147 @@
+//! can-utils, which this project did not write, on the same bus: `cansend` stops the robot,
+//! `candump -L` records a bus every frame of which decodes.
+
+use std::time::{Duration, Instant};
+
+use hil_tests::{candump, cansend, firmware, out_dir, read_candump, read_telemetry, Process, Vcan};
+use protocol::{decode_frame, AnyMessage, ControllerMode, EStop, EStopAction, NodeId};
+
+#[test]
+fn an_e_stop_from_cansend_stops_every_drive_within_one_control_period() {
+    let bus = Vcan::new();
+    let fw = firmware(&bus);
+    let out = out_dir("estop");
+    let log = out_dir("estop-dump").with_extension("log");
+    let dump = candump(&bus, &log);
+    let out_text = out.to_string_lossy().into_owned();
+    let sim = Process::start(
+        "sim-host",
+        &[
+            "run",
+            "--bus",
+            bus.name(),
+            "--no-plots",
+            "--no-progress",
+            "--duration",
+            "12",
+            "--drive",
+            "0:fold",
+            "--drive",
+            "3:W",
+            "--out",
+            &out_text,
+        ],
+    );
+    // Wait until the controller reports driving forward, then press the E-stop from a shell.
+    let started = Instant::now();
+    let mut driving = false;
+    while !driving && started.elapsed() < Duration::from_secs(300) {
+        std::thread::sleep(Duration::from_millis(20));
+        driving = read_candump(&log).iter().rev().take(50).any(|(_, f)| {
+            matches!(
+                decode_frame(f.id(), f.data()).map(|d| d.message),
+                Ok(AnyMessage::ControllerStatus(s)) if s.mode == ControllerMode::WheelForward
+            )
+        });
+    }
+    assert!(driving, "the robot never drove forward");
+    let latch = AnyMessage::EStop(EStop {
+        action: EStopAction::Latch,
+        source: NodeId::Tool,
+    })
+    .encode(0)
+    .unwrap();
+    cansend(&bus, &latch);
+    assert!(sim.wait(Duration::from_secs(600)).success());
+    let _ = fw.terminate();
+    let _ = dump.terminate();
+
+    // When the simulator saw the E-stop (its own log: simulation time).
+    let sim_log = read_candump(&out.join("bus.log"));
+    let estop_s = sim_log
+        .iter()
+        .find(|(_, f)| f.id() == 0x000)
+        .map(|(t, _)| *t)
+        .expect("the simulator's log has the E-stop");
+    let rows = read_telemetry(&out.join("telemetry.csv"));
+    let before: Vec<_> = rows.iter().filter(|(t, ..)| *t < estop_s).collect();
+    assert!(
+        before
+            .iter()
+            .rev()
+            .take(10)
+            .any(|(_, tq, _)| tq[0].abs() > 0.5),
+        "the wheels were driving before the E-stop"
+    );
+    // One control period (4 ms) after the frame, and ever after: no wheel torque.
+    let after: Vec<_> = rows
+        .iter()
+        .filter(|(t, ..)| *t > estop_s + 0.004 + 1e-9)
+        .collect();
+    assert!(!after.is_empty());
+    for (t, torque, _) in &after {
+        assert_eq!(
+            *torque,
+            [0.0, 0.0],
+            "wheel torque {torque:?} at {t} s, E-stop at {estop_s} s"
+        );
+    }
+    assert!(
+        after.iter().any(|(.., mode)| mode == "EStop"),
+        "the controller reports the E-stop"
+    );
+    println!("E-stop at {estop_s:.3} s: wheels off from the next cycle on");
+}
+
+#[test]
+fn candump_records_a_bus_on_which_every_frame_decodes() {
+    let bus = Vcan::new();
+    let fw = firmware(&bus);
+    let log = out_dir("dump").with_extension("log");
+    let dump = candump(&bus, &log);
+    std::thread::sleep(Duration::from_millis(200));
+    let out = out_dir("dump-run");
+    let out_text = out.to_string_lossy().into_owned();
+    let sim = Process::start(
+        "sim-host",
+        &[
+            "run",
+            "--bus",
+            bus.name(),
+            "--no-plots",
+            "--no-progress",
+            "--duration",
+            "3",
+            "--drive",
+            "0:W",
+            "--out",
+            &out_text,
+        ],
+    );
+    assert!(sim.wait(Duration::from_secs(600)).success());
+    std::thread::sleep(Duration::from_millis(300));
+    let _ = fw.terminate();
+    std::thread::sleep(Duration::from_millis(100));
+    let _ = dump.terminate();
+    let frames = read_candump(&log);
+    assert!(frames.len() > 3000, "only {} frames recorded", frames.len());
+    let mut ids = std::collections::BTreeSet::new();
+    for (t, frame) in &frames {
+        let decoded = decode_frame(frame.id(), frame.data())
+            .unwrap_or_else(|e| panic!("frame at {t} does not decode: {frame:?}: {e:?}"));
+        ids.insert(decoded.id.raw());
+    }
+    // Every node spoke: SYNC, commands, all feedback, teleop, controller and drive status.
+    for id in [
+        0x010, 0x100, 0x101, 0x180, 0x181, 0x182, 0x183, 0x184, 0x185, 0x200, 0x201, 0x400, 0x410,
+        0x414,
+    ] {
+        assert!(ids.contains(&id), "no frame with id {id:03X} in {ids:03X?}");
+    }
+    // Keep the log for the host-side cantools check (`cargo xtask hil` prints it).
+    let keep = std::env::var_os("HIL_KEEP_DUMP").map(std::path::PathBuf::from);
+    if let Some(path) = keep {
+        std::fs::copy(&log, path).unwrap();
+    }
+    println!("candump -L: {} frames, ids {ids:03X?}", frames.len());
+}
