@@ -22,7 +22,8 @@ Tasks:
                      when already done
   test               everything CI checks: fmt, clippy -D warnings (all features), DBC
                      freshness, no f64 in the no_std crates, all tests (the headless renderer's
-                     too), and a thumbv7em-none-eabihf build of the no_std crates
+                     too), a thumbv7em-none-eabihf build of the no_std crates, and the vcan
+                     suite (`hil`)
   dbc [--check]      regenerate protocol/hybrid_robot.dbc (--check: fail if the committed file is stale)
   busload            print the per-cycle frame schedule and the bus load at 250 Hz and 1 kHz
   bench [args]       criterion benchmarks (control step, raw MuJoCo step, closed-loop cycle), then a
