@@ -245,7 +245,6 @@ fn initramfs(kernel: &Kernel, suite: &[PathBuf]) -> Result<PathBuf, String> {
         "#!/bin/sh\n\
          export PATH=/bin:{tools}\n\
          mount -t proc proc /proc; mount -t sysfs sys /sys; mount -t devtmpfs dev /dev\n\
-         mount -t tmpfs tmp /tmp\n\
          for m in {modules}; do insmod $m || echo \"hil: insmod $m failed\"; done\n\
          echo \"hil: kernel $(uname -r), $(grep -c processor /proc/cpuinfo) CPUs\"\n\
          status=0\n\
