@@ -314,3 +314,13 @@ fn body_height_commands_are_held_within_1_cm_where_the_legs_reach() {
         );
     }
 }
+
+#[test]
+fn the_30_mode_pairs_in_one_run_keep_the_robot_up_and_in_limits() {
+    let segments = run("mode_pairs.toml");
+    assert_eq!(segments.len(), 31);
+    for s in &segments {
+        assert!(!s.fell, "{s:#?}");
+        assert_eq!(s.joint_limit_violations + s.torque_limit_violations, 0, "{s:#?}");
+    }
+}

@@ -47,3 +47,23 @@ fn l_over_vcan_trots_0_4_m_in_8_s() {
     assert!(figure(&summary, 1, "max_pitch_deg") <= 15.0);
     assert_eq!(figure(&summary, 1, "torso_on_ground_cycles"), 0.0);
 }
+
+#[test]
+fn all_30_mode_pairs_over_vcan_keep_the_robot_up_and_in_limits() {
+    let bus = Vcan::new();
+    let fw = firmware(&bus);
+    let out = out_dir("pairs");
+    let summary =
+        simulate(&bus, &out, &["--scenario", &scenario("mode_pairs.toml")]).expect("summary");
+    let _ = fw.terminate();
+    let segments = summary["segments"].as_array().expect("segments");
+    assert_eq!(segments.len(), 31);
+    for (i, s) in segments.iter().enumerate() {
+        let label = s["label"].as_str().unwrap_or("?");
+        assert_eq!(s["fell"].as_bool(), Some(false), "fell in {label}: {s}");
+        assert_eq!(figure(&summary, i, "joint_limit_violations"), 0.0, "{label}: {s}");
+        assert_eq!(figure(&summary, i, "torque_limit_violations"), 0.0, "{label}: {s}");
+    }
+    assert_eq!(summary["missed_cycles"].as_u64(), Some(0), "{summary}");
+    println!("30 mode pairs over vcan: no fall, no limit violation");
+}
