@@ -321,6 +321,10 @@ fn the_30_mode_pairs_in_one_run_keep_the_robot_up_and_in_limits() {
     assert_eq!(segments.len(), 31);
     for s in &segments {
         assert!(!s.fell, "{s:#?}");
-        assert_eq!(s.joint_limit_violations + s.torque_limit_violations, 0, "{s:#?}");
+        assert_eq!(
+            s.joint_limit_violations + s.torque_limit_violations,
+            0,
+            "{s:#?}"
+        );
     }
 }

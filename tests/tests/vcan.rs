@@ -61,8 +61,16 @@ fn all_30_mode_pairs_over_vcan_keep_the_robot_up_and_in_limits() {
     for (i, s) in segments.iter().enumerate() {
         let label = s["label"].as_str().unwrap_or("?");
         assert_eq!(s["fell"].as_bool(), Some(false), "fell in {label}: {s}");
-        assert_eq!(figure(&summary, i, "joint_limit_violations"), 0.0, "{label}: {s}");
-        assert_eq!(figure(&summary, i, "torque_limit_violations"), 0.0, "{label}: {s}");
+        assert_eq!(
+            figure(&summary, i, "joint_limit_violations"),
+            0.0,
+            "{label}: {s}"
+        );
+        assert_eq!(
+            figure(&summary, i, "torque_limit_violations"),
+            0.0,
+            "{label}: {s}"
+        );
     }
     assert_eq!(summary["missed_cycles"].as_u64(), Some(0), "{summary}");
     println!("30 mode pairs over vcan: no fall, no limit violation");
