@@ -52,7 +52,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
         eprintln!("hil: this kernel has vcan: running natively");
         for binary in &suite {
             sh(Command::new(binary)
-                .args(["--test-threads", "2"])
+                .args(["--test-threads", "2", "--show-output"])
                 .env("HIL_BIN_DIR", root().join("target").join("release")))?;
         }
         return Ok(());
@@ -248,7 +248,7 @@ fn initramfs(kernel: &Kernel, suite: &[PathBuf]) -> Result<PathBuf, String> {
          for m in {modules}; do insmod $m || echo \"hil: insmod $m failed\"; done\n\
          echo \"hil: kernel $(uname -r), $(grep -c processor /proc/cpuinfo) CPUs\"\n\
          status=0\n\
-         for suite in {suite}; do HIL_BIN_DIR={release} $suite --test-threads 2 || status=1; done\n\
+         for suite in {suite}; do HIL_BIN_DIR={release} $suite --test-threads 2 --show-output || status=1; done\n\
          echo \"{mark}$status\"\n\
          poweroff -f\n",
         tools = tool_dirs.join(":"),
