@@ -138,10 +138,11 @@ fn candump_records_a_bus_on_which_every_frame_decodes() {
     ] {
         assert!(ids.contains(&id), "no frame with id {id:03X} in {ids:03X?}");
     }
-    // Keep the log for the host-side cantools check (`cargo xtask hil` prints it).
-    let keep = std::env::var_os("HIL_KEEP_DUMP").map(std::path::PathBuf::from);
-    if let Some(path) = keep {
-        std::fs::copy(&log, path).unwrap();
+    // Hand the log to `cargo xtask hil`, which decodes it with Python cantools and the DBC.
+    if let Some(dir) = std::env::var_os("HIL_EXPORT_DIR") {
+        let dir = std::path::PathBuf::from(dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::copy(&log, dir.join("candump.log")).unwrap();
     }
     println!("candump -L: {} frames, ids {ids:03X?}", frames.len());
 }

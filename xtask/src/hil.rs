@@ -34,6 +34,9 @@ const MODULES: [&str; 4] = [
 const TOOLS: [&str; 4] = ["ip", "candump", "cansend", "canplayer"];
 /// The line the VM prints last: `HIL-EXIT <status>`.
 const EXIT_MARK: &str = "HIL-EXIT ";
+/// Between these lines the VM prints the suite's candump log, gzip'd and base64'd.
+const DUMP_BEGIN: &str = "HIL-CANDUMP-BEGIN";
+const DUMP_END: &str = "HIL-CANDUMP-END";
 
 pub fn run(args: &[String]) -> Result<(), String> {
     let force_vm = args.iter().any(|a| a == "--vm");
@@ -50,17 +53,52 @@ pub fn run(args: &[String]) -> Result<(), String> {
     let suite = build_suite()?;
     if !force_vm && native_vcan() {
         eprintln!("hil: this kernel has vcan: running natively");
+        let export = root().join(".cache").join("hil").join("export");
+        let _ = std::fs::remove_dir_all(&export);
         for binary in &suite {
             sh(Command::new(binary)
                 .args(["--test-threads", "2", "--show-output"])
-                .env("HIL_BIN_DIR", root().join("target").join("release")))?;
+                .env("HIL_BIN_DIR", root().join("target").join("release"))
+                .env("HIL_EXPORT_DIR", &export))?;
         }
-        return Ok(());
+        return cantools_check(&export.join("candump.log"));
     }
     eprintln!("hil: no vcan here: running the suite in a QEMU VM");
     let kernel = kernel()?;
     let initrd = initramfs(&kernel, &suite)?;
-    boot(&kernel.vmlinuz, &initrd)
+    let log = root().join(".cache").join("hil").join("candump.log");
+    boot(&kernel.vmlinuz, &initrd, &log)?;
+    cantools_check(&log)
+}
+
+/// Decodes a `candump -L` log of the suite with Python `cantools` and the project's DBC: every
+/// frame must decode.
+fn cantools_check(log: &Path) -> Result<(), String> {
+    if !log.exists() {
+        return Err(format!(
+            "the suite left no candump log at {} for the cantools check",
+            log.display()
+        ));
+    }
+    let script = "import sys, cantools\n\
+        from cantools.logreader import Parser\n\
+        db = cantools.database.load_file(sys.argv[1])\n\
+        n = bad = 0\n\
+        with open(sys.argv[2]) as f:\n\
+        \x20   for frame in Parser(f):\n\
+        \x20       n += 1\n\
+        \x20       try:\n\
+        \x20           db.decode_message(frame.frame_id, frame.data)\n\
+        \x20       except Exception as e:\n\
+        \x20           bad += 1\n\
+        \x20           print('cannot decode', hex(frame.frame_id), frame.data.hex(), e)\n\
+        print(f'cantools: {n} frames from candump -L, {bad} failed to decode')\n\
+        sys.exit(1 if bad or n < 3000 else 0)\n";
+    sh(Command::new(crate::setup::venv_python())
+        .args(["-c", script])
+        .arg(root().join("protocol").join("hybrid_robot.dbc"))
+        .arg(log))
+    .map_err(|e| format!("{e}: the recorded bus does not decode with the DBC"))
 }
 
 /// Builds the suite's test binaries in release; their paths.
@@ -248,7 +286,8 @@ fn initramfs(kernel: &Kernel, suite: &[PathBuf]) -> Result<PathBuf, String> {
          for m in {modules}; do insmod $m || echo \"hil: insmod $m failed\"; done\n\
          echo \"hil: kernel $(uname -r), $(grep -c processor /proc/cpuinfo) CPUs\"\n\
          status=0\n\
-         for suite in {suite}; do HIL_BIN_DIR={release} $suite --test-threads 2 --show-output || status=1; done\n\
+         for suite in {suite}; do HIL_BIN_DIR={release} HIL_EXPORT_DIR=/export $suite --test-threads 2 --show-output || status=1; done\n\
+         if [ -f /export/candump.log ]; then echo {begin}; gzip -c /export/candump.log | base64; echo {end}; fi\n\
          echo \"{mark}$status\"\n\
          poweroff -f\n",
         tools = tool_dirs.join(":"),
@@ -259,6 +298,8 @@ fn initramfs(kernel: &Kernel, suite: &[PathBuf]) -> Result<PathBuf, String> {
             .collect::<Vec<_>>()
             .join(" "),
         mark = EXIT_MARK,
+        begin = DUMP_BEGIN,
+        end = DUMP_END,
     );
     let init_path = dir.join("init");
     std::fs::write(&init_path, init).map_err(|e| e.to_string())?;
@@ -275,8 +316,9 @@ fn initramfs(kernel: &Kernel, suite: &[PathBuf]) -> Result<PathBuf, String> {
     Ok(initrd)
 }
 
-/// Boots the VM, streams its console, returns the suite's status.
-fn boot(vmlinuz: &Path, initrd: &Path) -> Result<(), String> {
+/// Boots the VM, streams its console (but for the candump log, which goes to `log`), returns
+/// the suite's status.
+fn boot(vmlinuz: &Path, initrd: &Path, log: &Path) -> Result<(), String> {
     let mut child = Command::new("qemu-system-x86_64")
         // `-cpu max`: libmujoco uses AVX, which the default qemu64 model lacks (SIGILL).
         .args([
@@ -299,9 +341,25 @@ fn boot(vmlinuz: &Path, initrd: &Path) -> Result<(), String> {
         })?;
     let stdout = child.stdout.take().ok_or("no console")?;
     let mut status = None;
+    let mut dump: Option<String> = None;
     for line in BufReader::new(stdout).lines().map_while(Result::ok) {
+        let trimmed = line.trim();
+        if trimmed == DUMP_BEGIN {
+            dump = Some(String::new());
+            continue;
+        }
+        if trimmed == DUMP_END {
+            if let Some(text) = dump.take() {
+                save_dump(&text, log)?;
+            }
+            continue;
+        }
+        if let Some(text) = dump.as_mut() {
+            text.push_str(trimmed);
+            continue;
+        }
         println!("{line}");
-        if let Some(code) = line.trim().strip_prefix(EXIT_MARK) {
+        if let Some(code) = trimmed.strip_prefix(EXIT_MARK) {
             status = code.trim().parse::<i32>().ok();
         }
     }
@@ -313,4 +371,18 @@ fn boot(vmlinuz: &Path, initrd: &Path) -> Result<(), String> {
             Err("the VM ended without reporting the suite's result (see its console above)".into())
         }
     }
+}
+
+/// Writes the VM's base64'd, gzip'd log to `log`, decoded with the system's base64 and gzip.
+fn save_dump(base64_text: &str, log: &Path) -> Result<(), String> {
+    let encoded = log.with_extension("gz.b64");
+    std::fs::write(&encoded, base64_text).map_err(|e| format!("{}: {e}", encoded.display()))?;
+    sh(Command::new("sh").args([
+        "-c",
+        &format!(
+            "base64 -d '{}' | gzip -dc > '{}'",
+            encoded.display(),
+            log.display()
+        ),
+    ]))
 }
