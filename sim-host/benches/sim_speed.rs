@@ -58,6 +58,7 @@ fn closed_loop(c: &mut Criterion) {
     let options = LockstepOptions {
         cycles: 1,
         reply_timeout: Duration::ZERO,
+        max_speed: None,
     };
     c.bench_function("closed_loop_cycle", |b| {
         b.iter(|| {

@@ -21,6 +21,10 @@ pub struct LockstepOptions {
     pub cycles: u64,
     /// How long to wait for the controller's command each cycle.
     pub reply_timeout: Duration,
+    /// Run at most this many times real time (`None`: as fast as possible). Still lockstep and
+    /// deterministic; paced so that people and outside tools (cansend, canplayer) see the
+    /// simulation at a speed they can act in.
+    pub max_speed: Option<f64>,
 }
 
 /// Runs `options.cycles` cycles. `peers(cycle)` runs after the simulator has sent its frames
@@ -80,6 +84,12 @@ pub fn run(
         recorder.row(sim.telemetry());
         if !observe(sim, &stats) {
             break;
+        }
+        if let Some(speed) = options.max_speed.filter(|s| *s > 0.0) {
+            let due = started + Duration::from_secs_f64(sim.time_s() / speed);
+            if let Some(wait) = due.checked_duration_since(Instant::now()) {
+                std::thread::sleep(wait);
+            }
         }
     }
     stats.sim_s = sim.time_s();

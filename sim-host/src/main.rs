@@ -87,6 +87,10 @@ struct RunArgs {
     /// Control rate, Hz (the model's timestep must divide the period).
     #[arg(long, default_value_t = 250)]
     control_hz: u32,
+    /// Lockstep: run at most this many times real time (1 = real time), still deterministic —
+    /// for watching, and for outside tools such as cansend and canplayer.
+    #[arg(long)]
+    pace: Option<f64>,
     /// Lockstep: how long to wait for the controller's command each cycle, ms.
     #[arg(long, default_value_t = 100)]
     reply_timeout_ms: u64,
@@ -240,6 +244,7 @@ fn run(args: RunArgs) -> Result<(), String> {
         duration_s: duration,
         control_hz: args.control_hz,
         reply_timeout: Duration::from_millis(args.reply_timeout_ms),
+        max_speed: args.pace,
         imu_noise: ImuNoise {
             gyro_std_rad_s: args.gyro_noise,
             gyro_bias_rad_s: [args.gyro_bias; 3],

@@ -70,6 +70,8 @@ pub struct SessionConfig {
     pub control_hz: u32,
     /// Lockstep: how long to wait for the controller each cycle.
     pub reply_timeout: Duration,
+    /// Lockstep: at most this many times real time (`None`: as fast as possible).
+    pub max_speed: Option<f64>,
     /// IMU noise.
     pub imu_noise: ImuNoise,
     /// Operator commands to send (empty: no teleop node on the bus).
@@ -445,6 +447,7 @@ fn drive(
             LockstepOptions {
                 cycles,
                 reply_timeout: config.reply_timeout,
+                max_speed: config.max_speed,
             },
             peers,
             observe,

@@ -144,6 +144,7 @@ fn run(
         LockstepOptions {
             cycles,
             reply_timeout: Duration::ZERO,
+            max_speed: None,
         },
         |_| {
             controller.borrow_mut().service();

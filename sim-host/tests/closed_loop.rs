@@ -26,6 +26,7 @@ fn config(plan: Vec<PlanStep>, segments: Vec<SegmentSpec>, duration_s: f64) -> S
         duration_s,
         control_hz: 250,
         reply_timeout: Duration::from_millis(100),
+        max_speed: None,
         imu_noise: ImuNoise::default(),
         teleop_plan: plan,
         out_dir: None,

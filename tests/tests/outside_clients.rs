@@ -125,6 +125,36 @@ fn candump_records_a_bus_on_which_every_frame_decodes() {
     let _ = dump.terminate();
     let frames = read_candump(&log);
     assert!(frames.len() > 3000, "only {} frames recorded", frames.len());
+    // SIGTERM made the firmware stop the drives on its way out: its last commands are legs
+    // torque-free and zero wheel torque.
+    let last = |id: u16| {
+        frames
+            .iter()
+            .rev()
+            .find(|(_, f)| f.id() == id)
+            .and_then(|(_, f)| decode_frame(f.id(), f.data()).ok())
+            .map(|d| d.message)
+    };
+    match last(0x100) {
+        Some(AnyMessage::LegTargets(t)) => {
+            assert_eq!(
+                t.enable,
+                protocol::DriveEnable::Disabled,
+                "last leg targets {t:?}"
+            )
+        }
+        other => panic!("no leg targets: {other:?}"),
+    }
+    match last(0x101) {
+        Some(AnyMessage::WheelCommand(w)) => {
+            assert_eq!(
+                w.torque.map(|t| t.raw()),
+                [0, 0],
+                "last wheel command {w:?}"
+            )
+        }
+        other => panic!("no wheel command: {other:?}"),
+    }
     let mut ids = std::collections::BTreeSet::new();
     for (t, frame) in &frames {
         let decoded = decode_frame(frame.id(), frame.data())
@@ -226,5 +256,68 @@ fn canplayer_replays_a_recorded_teleop_session_and_the_robot_repeats_it() {
     assert!(
         (replayed - recorded).abs() <= 0.3 * recorded,
         "replayed {replayed:.3} m vs recorded {recorded:.3} m"
+    );
+}
+
+#[test]
+fn a_teleop_command_from_cansend_folds_the_robot_onto_its_wheels() {
+    let bus = Vcan::new();
+    let fw = firmware(&bus);
+    let log = out_dir("teleop-dump").with_extension("log");
+    let dump = candump(&bus, &log);
+    let out = out_dir("teleop");
+    let out_text = out.to_string_lossy().into_owned();
+    // Lockstep, paced to real time at most, so that a shell command lands in time.
+    let sim = Process::start(
+        "sim-host",
+        &[
+            "run",
+            "--bus",
+            bus.name(),
+            "--no-plots",
+            "--no-progress",
+            "--duration",
+            "8",
+            "--pace",
+            "1",
+            "--out",
+            &out_text,
+        ],
+    );
+    // Once the controller reports (it stands in Stop), send `fold` from a shell.
+    let started = Instant::now();
+    let mut up = false;
+    while !up && started.elapsed() < Duration::from_secs(120) {
+        std::thread::sleep(Duration::from_millis(20));
+        up = read_candump(&log).iter().any(|(_, f)| f.id() == 0x400);
+    }
+    assert!(up, "the controller never reported");
+    let fold = AnyMessage::TeleopCommand(protocol::TeleopCommand {
+        mode: protocol::TeleopMode::Fold,
+        body_height: protocol::BodyHeight::saturating_from_si(0.0),
+        speed_scale: protocol::SpeedScale::saturating_from_si(100.0),
+    })
+    .encode(0)
+    .unwrap();
+    cansend(&bus, &fold);
+    assert!(sim.wait(Duration::from_secs(600)).success());
+    let _ = fw.terminate();
+    let _ = dump.terminate();
+    let rows = read_telemetry(&out.join("telemetry.csv"));
+    assert!(
+        rows.iter().any(|(.., mode)| mode == "Folding"),
+        "never folded"
+    );
+    let text = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    let heights: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.split(',').nth(3).and_then(|z| z.parse().ok()))
+        .collect();
+    let (first, last) = (heights[0], *heights.last().unwrap());
+    println!("cansend fold: torso {first:.3} m → {last:.3} m");
+    assert!(
+        first > 0.35 && last < 0.30,
+        "torso {first:.3} → {last:.3} m"
     );
 }
