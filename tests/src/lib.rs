@@ -187,20 +187,26 @@ pub fn firmware(bus: &Vcan) -> Process {
     )
 }
 
-/// Runs `sim-host run` on `bus` with `args`; returns the parsed `summary.json` if it wrote one.
-pub fn simulate(bus: &Vcan, out: &Path, args: &[&str]) -> Option<serde_json::Value> {
+/// Starts `sim-host run` on `bus` (an interface, or `inproc`) writing to `out`, without plots
+/// or progress bar, with `args` added.
+pub fn start_sim(bus: &str, out: &Path, args: &[&str]) -> Process {
     let out_text = out.to_string_lossy().into_owned();
     let mut all = vec![
         "run",
         "--bus",
-        bus.name(),
+        bus,
         "--no-plots",
         "--no-progress",
         "--out",
         &out_text,
     ];
     all.extend_from_slice(args);
-    let status = Process::start("sim-host", &all).wait(Duration::from_secs(600));
+    Process::start("sim-host", &all)
+}
+
+/// Runs `sim-host run` on `bus` with `args`; returns the parsed `summary.json` if it wrote one.
+pub fn simulate(bus: &Vcan, out: &Path, args: &[&str]) -> Option<serde_json::Value> {
+    let status = start_sim(bus.name(), out, args).wait(Duration::from_secs(600));
     assert!(status.success(), "sim-host failed: {status}");
     std::fs::read_to_string(out.join("summary.json"))
         .ok()

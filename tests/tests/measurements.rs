@@ -6,7 +6,9 @@
 
 use std::time::Duration;
 
-use hil_tests::{candump, firmware, out_dir, read_candump, scenario, simulate, Process, Vcan};
+use hil_tests::{
+    candump, firmware, out_dir, read_candump, scenario, simulate, start_sim, Process, Vcan,
+};
 use protocol::busload::{bus_load, fd_frame_bits, ROBOT_BUS};
 use protocol::MessageId;
 
@@ -18,21 +20,8 @@ fn steps_per_s(summary: &serde_json::Value) -> f64 {
 fn lockstep_over_vcan_keeps_at_least_half_the_in_process_speed() {
     let w = scenario("w.toml");
     let inproc_out = out_dir("speed-inproc");
-    let status = Process::start(
-        "sim-host",
-        &[
-            "run",
-            "--bus",
-            "inproc",
-            "--no-plots",
-            "--no-progress",
-            "--scenario",
-            &w,
-            "--out",
-            &inproc_out.to_string_lossy(),
-        ],
-    )
-    .wait(Duration::from_secs(600));
+    let status =
+        start_sim("inproc", &inproc_out, &["--scenario", &w]).wait(Duration::from_secs(600));
     assert!(status.success());
     let inproc: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(inproc_out.join("summary.json")).unwrap())
@@ -57,23 +46,8 @@ fn the_bus_load_candump_sees_matches_the_computed_schedule() {
     std::thread::sleep(Duration::from_millis(200));
     let fw = firmware(&bus);
     let out = out_dir("load-run");
-    let status = Process::start(
-        "sim-host",
-        &[
-            "run",
-            "--bus",
-            bus.name(),
-            "--no-plots",
-            "--no-progress",
-            "--duration",
-            "4",
-            "--drive",
-            "0:L",
-            "--out",
-            &out.to_string_lossy(),
-        ],
-    )
-    .wait(Duration::from_secs(600));
+    let status = start_sim(bus.name(), &out, &["--duration", "4", "--drive", "0:L"])
+        .wait(Duration::from_secs(600));
     assert!(status.success());
     std::thread::sleep(Duration::from_millis(300));
     let _ = fw.terminate();
@@ -120,23 +94,8 @@ fn real_time_control_period_jitter_and_feedback_to_command_latency() {
         &["--bus", bus.name(), "--clock", "timer", "--rate-hz", "250"],
     );
     let out = out_dir("jitter-run");
-    let status = Process::start(
-        "sim-host",
-        &[
-            "run",
-            "--bus",
-            bus.name(),
-            "--mode",
-            "realtime",
-            "--no-plots",
-            "--no-progress",
-            "--duration",
-            "3",
-            "--out",
-            &out.to_string_lossy(),
-        ],
-    )
-    .wait(Duration::from_secs(600));
+    let status = start_sim(bus.name(), &out, &["--mode", "realtime", "--duration", "3"])
+        .wait(Duration::from_secs(600));
     assert!(status.success());
     let _ = fw.terminate();
     std::thread::sleep(Duration::from_millis(100));

@@ -3,7 +3,9 @@
 
 use std::time::{Duration, Instant};
 
-use hil_tests::{candump, cansend, firmware, out_dir, read_candump, read_telemetry, Process, Vcan};
+use hil_tests::{
+    candump, cansend, firmware, out_dir, read_candump, read_telemetry, start_sim, Process, Vcan,
+};
 use protocol::{decode_frame, AnyMessage, ControllerMode, EStop, EStopAction, NodeId};
 
 #[test]
@@ -13,24 +15,10 @@ fn an_e_stop_from_cansend_stops_every_drive_within_one_control_period() {
     let out = out_dir("estop");
     let log = out_dir("estop-dump").with_extension("log");
     let dump = candump(&bus, &log);
-    let out_text = out.to_string_lossy().into_owned();
-    let sim = Process::start(
-        "sim-host",
-        &[
-            "run",
-            "--bus",
-            bus.name(),
-            "--no-plots",
-            "--no-progress",
-            "--duration",
-            "12",
-            "--drive",
-            "0:fold",
-            "--drive",
-            "3:W",
-            "--out",
-            &out_text,
-        ],
+    let sim = start_sim(
+        bus.name(),
+        &out,
+        &["--duration", "12", "--drive", "0:fold", "--drive", "3:W"],
     );
     // Wait until the controller reports driving forward, then press the E-stop from a shell.
     let started = Instant::now();
@@ -101,23 +89,7 @@ fn candump_records_a_bus_on_which_every_frame_decodes() {
     let dump = candump(&bus, &log);
     std::thread::sleep(Duration::from_millis(200));
     let out = out_dir("dump-run");
-    let out_text = out.to_string_lossy().into_owned();
-    let sim = Process::start(
-        "sim-host",
-        &[
-            "run",
-            "--bus",
-            bus.name(),
-            "--no-plots",
-            "--no-progress",
-            "--duration",
-            "3",
-            "--drive",
-            "0:W",
-            "--out",
-            &out_text,
-        ],
-    );
+    let sim = start_sim(bus.name(), &out, &["--duration", "3", "--drive", "0:W"]);
     assert!(sim.wait(Duration::from_secs(600)).success());
     std::thread::sleep(Duration::from_millis(300));
     let _ = fw.terminate();
@@ -183,20 +155,9 @@ fn candump_records_a_bus_on_which_every_frame_decodes() {
 /// only where the simulator keeps up with the wall clock, which an emulated VM does not.)
 fn lockstep_pair(bus: &Vcan, out: &std::path::Path, extra: &[&str]) -> (Process, Process) {
     let fw = firmware(bus);
-    let out_text = out.to_string_lossy().into_owned();
-    let mut args = vec![
-        "run",
-        "--bus",
-        bus.name(),
-        "--no-plots",
-        "--no-progress",
-        "--duration",
-        "8",
-        "--out",
-        &out_text,
-    ];
+    let mut args = vec!["--duration", "8"];
     args.extend_from_slice(extra);
-    let sim = Process::start("sim-host", &args);
+    let sim = start_sim(bus.name(), out, &args);
     (fw, sim)
 }
 
@@ -266,24 +227,8 @@ fn a_teleop_command_from_cansend_folds_the_robot_onto_its_wheels() {
     let log = out_dir("teleop-dump").with_extension("log");
     let dump = candump(&bus, &log);
     let out = out_dir("teleop");
-    let out_text = out.to_string_lossy().into_owned();
     // Lockstep, paced to real time at most, so that a shell command lands in time.
-    let sim = Process::start(
-        "sim-host",
-        &[
-            "run",
-            "--bus",
-            bus.name(),
-            "--no-plots",
-            "--no-progress",
-            "--duration",
-            "8",
-            "--pace",
-            "1",
-            "--out",
-            &out_text,
-        ],
-    );
+    let sim = start_sim(bus.name(), &out, &["--duration", "8", "--pace", "1"]);
     // Once the controller reports (it stands in Stop), send `fold` from a shell.
     let started = Instant::now();
     let mut up = false;
