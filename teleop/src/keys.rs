@@ -1,0 +1,91 @@
+//! The operator's keys: the report's W/S/A/L/K/X, and what a real robot needs besides.
+//!
+//! | key            | action                                   |
+//! |----------------|------------------------------------------|
+//! | `W` `S` `A`    | wheels forward, backward, rotate          |
+//! | `L` `K`        | trot forward, backward                   |
+//! | `X`            | stop                                     |
+//! | `T` / `F`      | stand on the legs / fold onto the wheels |
+//! | `↑` `↓`        | body height +1 cm / −1 cm                |
+//! | `]` `[`        | speed scale +10 % / −10 %                |
+//! | space          | E-stop (latches)                         |
+//! | `R` then `R`   | release a latched E-stop (within 2 s)    |
+//! | `Q`, Esc       | quit (the controller stops within 500 ms) |
+
+use protocol::TeleopMode;
+
+/// A key press, as the terminal reports it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Key {
+    /// A printable character.
+    Char(char),
+    /// Arrow up.
+    Up,
+    /// Arrow down.
+    Down,
+    /// Escape.
+    Esc,
+}
+
+/// What a key asks for.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Action {
+    /// Command a mode.
+    Mode(TeleopMode),
+    /// Change the body height by this much, m.
+    Height(f32),
+    /// Change the speed scale by this much, %.
+    Speed(f32),
+    /// Latch the E-stop.
+    EStop,
+    /// One press of the release sequence.
+    Release,
+    /// Leave.
+    Quit,
+}
+
+/// The action of `key`, `None` for a key with no meaning.
+pub fn action(key: Key) -> Option<Action> {
+    Some(match key {
+        Key::Up => Action::Height(0.01),
+        Key::Down => Action::Height(-0.01),
+        Key::Esc => Action::Quit,
+        Key::Char(c) => match c.to_ascii_uppercase() {
+            ' ' => Action::EStop,
+            'T' => Action::Mode(TeleopMode::Stand),
+            'F' => Action::Mode(TeleopMode::Fold),
+            ']' => Action::Speed(10.0),
+            '[' => Action::Speed(-10.0),
+            'R' => Action::Release,
+            'Q' => Action::Quit,
+            other => Action::Mode(TeleopMode::from_key(other)?),
+        },
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_reports_keys_and_the_others() {
+        let mode = |c| action(Key::Char(c));
+        for (c, m) in [
+            ('w', TeleopMode::WheelForward),
+            ('S', TeleopMode::WheelBackward),
+            ('a', TeleopMode::WheelRotate),
+            ('l', TeleopMode::TrotForward),
+            ('k', TeleopMode::TrotBackward),
+            ('x', TeleopMode::Stop),
+            ('t', TeleopMode::Stand),
+            ('f', TeleopMode::Fold),
+        ] {
+            assert_eq!(mode(c), Some(Action::Mode(m)), "{c}");
+        }
+        assert_eq!(mode(' '), Some(Action::EStop));
+        assert_eq!(action(Key::Up), Some(Action::Height(0.01)));
+        assert_eq!(mode('['), Some(Action::Speed(-10.0)));
+        assert_eq!(mode('z'), None);
+        assert_eq!(action(Key::Esc), Some(Action::Quit));
+    }
+}

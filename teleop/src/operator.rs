@@ -1,0 +1,278 @@
+//! The operator as a CAN node. It sends the teleop command whenever it changes and again every
+//! 20 ms, and a heartbeat every 20 ms, so the controller knows someone is at the keys: when
+//! the heartbeat stops (teleop quit or died) the controller stops the robot within 500 ms.
+//! Space latches an E-stop at once; releasing it takes `R` twice within 2 s, so that no single
+//! stray key does it.
+
+use protocol::{
+    AnyMessage, BodyHeight, E2eCounter, EStop, EStopAction, EncodeError, Frame, Millis, NodeId,
+    SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode,
+};
+
+use crate::keys::Action;
+
+/// Period of the command and heartbeat, ms (50 Hz).
+pub const PERIOD_MS: u64 = 20;
+/// Window in which the second `R` releases the E-stop, ms.
+pub const RELEASE_WINDOW_MS: u64 = 2_000;
+/// Body-height range of the wire, m.
+pub const BODY_HEIGHT_RANGE_M: (f32, f32) = (-0.10, 0.12);
+
+/// What a key press led to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// Keep going.
+    Continue,
+    /// The operator asked to leave.
+    Quit,
+}
+
+/// The operator's state and its bus traffic.
+#[derive(Debug, Clone)]
+pub struct Operator {
+    mode: TeleopMode,
+    body_height_m: f32,
+    speed_scale_pct: f32,
+    estop_latched: bool,
+    release_armed_at_ms: Option<u64>,
+    pending_estop: Option<EStopAction>,
+    command_changed: bool,
+    next_send_ms: u64,
+    command_counter: E2eCounter,
+    heartbeat_counter: E2eCounter,
+    estop_counter: E2eCounter,
+}
+
+impl Default for Operator {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Operator {
+    /// At STOP, nominal height, full speed, no E-stop.
+    pub fn new() -> Self {
+        Self {
+            mode: TeleopMode::Stop,
+            body_height_m: 0.0,
+            speed_scale_pct: 100.0,
+            estop_latched: false,
+            release_armed_at_ms: None,
+            pending_estop: None,
+            command_changed: true,
+            next_send_ms: 0,
+            command_counter: E2eCounter::default(),
+            heartbeat_counter: E2eCounter::default(),
+            estop_counter: E2eCounter::default(),
+        }
+    }
+
+    /// The commanded mode.
+    pub fn mode(&self) -> TeleopMode {
+        self.mode
+    }
+
+    /// The commanded body-height offset, m.
+    pub fn body_height_m(&self) -> f32 {
+        self.body_height_m
+    }
+
+    /// The commanded speed scale, %.
+    pub fn speed_scale_pct(&self) -> f32 {
+        self.speed_scale_pct
+    }
+
+    /// Whether this operator latched an E-stop that is not yet released.
+    pub fn estop_latched(&self) -> bool {
+        self.estop_latched
+    }
+
+    /// Whether one `R` has been pressed and a second within the window would release.
+    pub fn release_armed(&self, now_ms: u64) -> bool {
+        self.release_armed_at_ms
+            .is_some_and(|t| now_ms.saturating_sub(t) <= RELEASE_WINDOW_MS)
+    }
+
+    /// Takes one key action at `now_ms`.
+    pub fn press(&mut self, now_ms: u64, action: Action) -> Outcome {
+        if action != Action::Release {
+            self.release_armed_at_ms = None;
+        }
+        match action {
+            Action::Mode(mode) => {
+                self.command_changed |= mode != self.mode;
+                self.mode = mode;
+            }
+            Action::Height(step_m) => {
+                let (low, high) = BODY_HEIGHT_RANGE_M;
+                let height = (self.body_height_m + step_m).clamp(low, high);
+                // Whole centimetres, so repeated steps do not drift.
+                let height = (height * 100.0).round() / 100.0;
+                self.command_changed |= height != self.body_height_m;
+                self.body_height_m = height;
+            }
+            Action::Speed(step_pct) => {
+                let speed = (self.speed_scale_pct + step_pct).clamp(0.0, 100.0);
+                self.command_changed |= speed != self.speed_scale_pct;
+                self.speed_scale_pct = speed;
+            }
+            Action::EStop => {
+                self.estop_latched = true;
+                self.pending_estop = Some(EStopAction::Latch);
+                // After a stop, motion must be asked for again.
+                self.mode = TeleopMode::Stop;
+                self.command_changed = true;
+            }
+            Action::Release => {
+                if self.release_armed(now_ms) {
+                    self.release_armed_at_ms = None;
+                    if self.estop_latched {
+                        self.estop_latched = false;
+                        self.pending_estop = Some(EStopAction::Clear);
+                    }
+                } else {
+                    self.release_armed_at_ms = Some(now_ms);
+                }
+            }
+            Action::Quit => return Outcome::Quit,
+        }
+        Outcome::Continue
+    }
+
+    /// The frames due at `now_ms`: an E-stop latch or clear at once, the command at once when it
+    /// changed, and the command and heartbeat every [`PERIOD_MS`].
+    pub fn poll(&mut self, now_ms: u64) -> Result<Vec<Frame>, EncodeError> {
+        let mut frames = Vec::with_capacity(3);
+        if let Some(action) = self.pending_estop.take() {
+            let estop = AnyMessage::EStop(EStop {
+                action,
+                source: NodeId::Teleop,
+            });
+            frames.push(estop.encode(self.estop_counter.advance())?);
+        }
+        let periodic = now_ms >= self.next_send_ms;
+        if self.command_changed || periodic {
+            let command = AnyMessage::TeleopCommand(TeleopCommand {
+                mode: self.mode,
+                body_height: BodyHeight::saturating_from_si(self.body_height_m),
+                speed_scale: SpeedScale::saturating_from_si(self.speed_scale_pct),
+            });
+            frames.push(command.encode(self.command_counter.advance())?);
+            self.command_changed = false;
+        }
+        if periodic {
+            let uptime = u32::try_from(now_ms).unwrap_or(u32::MAX);
+            let heartbeat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
+                uptime: Millis::from_raw(uptime).unwrap_or(Millis::saturating_from_si(0.0)),
+            });
+            frames.push(heartbeat.encode(self.heartbeat_counter.advance())?);
+            self.next_send_ms = now_ms - now_ms % PERIOD_MS + PERIOD_MS;
+        }
+        Ok(frames)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::keys::{action, Key};
+    use protocol::{MessageId, Receiver};
+
+    fn decode(frames: &[Frame], rx: &mut Receiver) -> Vec<AnyMessage> {
+        frames
+            .iter()
+            .map(|f| rx.receive(f.id(), f.data()).unwrap().message)
+            .collect()
+    }
+
+    #[test]
+    fn a_key_goes_out_at_once_and_the_command_and_heartbeat_every_20_ms() {
+        let mut op = Operator::new();
+        let mut rx = Receiver::default();
+        let first = decode(&op.poll(0).unwrap(), &mut rx);
+        assert_eq!(first.len(), 2, "command and heartbeat at start: {first:?}");
+        assert!(op.poll(5).unwrap().is_empty(), "nothing between periods");
+        op.press(7, action(Key::Char('w')).unwrap());
+        let now = decode(&op.poll(7).unwrap(), &mut rx);
+        assert!(matches!(
+            now.as_slice(),
+            [AnyMessage::TeleopCommand(TeleopCommand {
+                mode: TeleopMode::WheelForward,
+                ..
+            })]
+        ));
+        let periodic = op.poll(20).unwrap();
+        let ids: Vec<u16> = periodic.iter().map(Frame::id).collect();
+        assert_eq!(
+            ids,
+            [
+                MessageId::TeleopCommand.raw(),
+                MessageId::TeleopHeartbeat.raw()
+            ]
+        );
+        // One second of polling every ms: 50 heartbeats.
+        let beats = (21..1021)
+            .flat_map(|t| op.poll(t).unwrap())
+            .filter(|f| f.id() == MessageId::TeleopHeartbeat.raw())
+            .count();
+        assert_eq!(beats, 50);
+    }
+
+    #[test]
+    fn space_latches_at_once_and_only_r_twice_within_2_s_releases() {
+        let mut op = Operator::new();
+        let mut rx = Receiver::default();
+        op.poll(0).unwrap();
+        op.press(1, action(Key::Char('l')).unwrap());
+        op.press(2, action(Key::Char(' ')).unwrap());
+        let frames = decode(&op.poll(2).unwrap(), &mut rx);
+        assert!(matches!(
+            frames.first(),
+            Some(AnyMessage::EStop(EStop {
+                action: EStopAction::Latch,
+                ..
+            }))
+        ));
+        assert_eq!(
+            op.mode(),
+            TeleopMode::Stop,
+            "motion must be asked for again"
+        );
+        // R, then too late: nothing; R, R in time: released.
+        op.press(100, Action::Release);
+        op.press(100 + RELEASE_WINDOW_MS + 1, Action::Release);
+        assert!(op.estop_latched() && op.release_armed(100 + RELEASE_WINDOW_MS + 1));
+        op.press(3_000, action(Key::Char('w')).unwrap());
+        op.press(3_001, Action::Release);
+        assert!(
+            op.estop_latched(),
+            "a key between the two R disarms the release"
+        );
+        op.press(3_500, Action::Release);
+        assert!(!op.estop_latched());
+        let frames = decode(&op.poll(3_500).unwrap(), &mut rx);
+        assert!(matches!(
+            frames.first(),
+            Some(AnyMessage::EStop(EStop {
+                action: EStopAction::Clear,
+                ..
+            }))
+        ));
+    }
+
+    #[test]
+    fn height_and_speed_stay_in_their_wire_ranges() {
+        let mut op = Operator::new();
+        for _ in 0..30 {
+            op.press(0, Action::Height(0.01));
+            op.press(0, Action::Speed(10.0));
+        }
+        assert_eq!((op.body_height_m(), op.speed_scale_pct()), (0.12, 100.0));
+        for _ in 0..30 {
+            op.press(0, Action::Height(-0.01));
+            op.press(0, Action::Speed(-10.0));
+        }
+        assert_eq!((op.body_height_m(), op.speed_scale_pct()), (-0.10, 0.0));
+        assert_eq!(op.press(0, Action::Quit), Outcome::Quit);
+    }
+}
