@@ -266,3 +266,66 @@ fn a_teleop_command_from_cansend_folds_the_robot_onto_its_wheels() {
         "torso {first:.3} → {last:.3} m"
     );
 }
+
+#[test]
+fn teleop_send_from_a_script_folds_the_robot_and_the_controller_stops_when_it_quits() {
+    let bus = Vcan::new();
+    let fw = firmware(&bus);
+    let log = out_dir("script-dump").with_extension("log");
+    let dump = candump(&bus, &log);
+    let out = out_dir("script");
+    let sim = start_sim(bus.name(), &out, &["--duration", "8", "--pace", "1"]);
+    let started = Instant::now();
+    let mut up = false;
+    while !up && started.elapsed() < Duration::from_secs(120) {
+        std::thread::sleep(Duration::from_millis(20));
+        up = read_candump(&log).iter().any(|(_, f)| f.id() == 0x400);
+    }
+    assert!(up, "the controller never reported");
+    let teleop = Process::start("teleop", &["--bus", bus.name(), "send", "F", "--for", "2"]);
+    assert!(
+        teleop.wait(Duration::from_secs(60)).success(),
+        "teleop send failed"
+    );
+    assert!(sim.wait(Duration::from_secs(600)).success());
+    let _ = fw.terminate();
+    let _ = dump.terminate();
+    let rows = read_telemetry(&out.join("telemetry.csv"));
+    assert!(
+        rows.iter().any(|(.., mode)| mode == "Folding"),
+        "never folded"
+    );
+    let frames = read_candump(&log);
+    let beats = frames.iter().filter(|(_, f)| f.id() == 0x201).count();
+    assert!(beats >= 90, "{beats} heartbeats in 2 s");
+    // After teleop quit, the controller stops within 500 ms (simulated time, from the
+    // simulator's own log). It says so in its next status frame: up to one status period
+    // (20 ms) and a cycle's frame order (4 ms each way) later.
+    let sim_log = read_candump(&out.join("bus.log"));
+    let last_beat = sim_log
+        .iter()
+        .filter(|(_, f)| f.id() == 0x201)
+        .map(|(t, _)| *t)
+        .fold(f64::NAN, f64::max);
+    let noticed = sim_log
+        .iter()
+        .filter(|(t, _)| *t > last_beat)
+        .find(|(_, f)| {
+            matches!(
+                decode_frame(f.id(), f.data()).map(|d| d.message),
+                Ok(AnyMessage::ControllerStatus(s))
+                    if s.faults.contains(protocol::FaultFlags::TELEOP_TIMEOUT)
+            )
+        })
+        .map(|(t, _)| *t)
+        .expect("the controller never reported the lost operator");
+    println!(
+        "teleop send F: {beats} heartbeats; operator lost reported {:.0} ms after the last",
+        (noticed - last_beat) * 1e3
+    );
+    assert!(
+        noticed - last_beat <= 0.52,
+        "reported after {:.3} s",
+        noticed - last_beat
+    );
+}

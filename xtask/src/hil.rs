@@ -49,6 +49,8 @@ pub fn run(args: &[String]) -> Result<(), String> {
         "sim-host",
         "-p",
         "firmware-host",
+        "-p",
+        "teleop",
     ]))?;
     let suite = build_suite()?;
     if !force_vm && native_vcan() {
@@ -260,7 +262,7 @@ fn initramfs(kernel: &Kernel, suite: &[PathBuf]) -> Result<PathBuf, String> {
         copy_with_libraries(&dir, &which(tool)?)?;
     }
     let release = root().join("target").join("release");
-    for program in ["sim-host", "firmware-host"] {
+    for program in ["sim-host", "firmware-host", "teleop"] {
         copy_with_libraries(&dir, &release.join(program))?;
     }
     for binary in suite {
