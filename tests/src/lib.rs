@@ -335,3 +335,20 @@ pub fn read_telemetry(path: &Path) -> Vec<(f64, [f64; 2], String)> {
         })
         .collect()
 }
+
+/// Polls the `candump` log at `path` every 20 ms until `seen` holds for its frames, at most
+/// `timeout`; whether it did.
+pub fn wait_for_log(
+    path: &Path,
+    timeout: Duration,
+    seen: impl Fn(&[(f64, protocol::Frame)]) -> bool,
+) -> bool {
+    let started = Instant::now();
+    while started.elapsed() < timeout {
+        std::thread::sleep(Duration::from_millis(20));
+        if seen(&read_candump(path)) {
+            return true;
+        }
+    }
+    false
+}

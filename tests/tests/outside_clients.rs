@@ -1,10 +1,11 @@
 //! can-utils, which this project did not write, on the same bus: `cansend` stops the robot,
 //! `candump -L` records a bus every frame of which decodes.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use hil_tests::{
-    candump, cansend, firmware, out_dir, read_candump, read_telemetry, start_sim, Process, Vcan,
+    candump, cansend, firmware, out_dir, read_candump, read_telemetry, start_sim, wait_for_log,
+    Process, Vcan,
 };
 use protocol::{decode_frame, AnyMessage, ControllerMode, EStop, EStopAction, NodeId};
 
@@ -21,17 +22,14 @@ fn an_e_stop_from_cansend_stops_every_drive_within_one_control_period() {
         &["--duration", "12", "--drive", "0:fold", "--drive", "3:W"],
     );
     // Wait until the controller reports driving forward, then press the E-stop from a shell.
-    let started = Instant::now();
-    let mut driving = false;
-    while !driving && started.elapsed() < Duration::from_secs(300) {
-        std::thread::sleep(Duration::from_millis(20));
-        driving = read_candump(&log).iter().rev().take(50).any(|(_, f)| {
+    let driving = wait_for_log(&log, Duration::from_secs(300), |frames| {
+        frames.iter().rev().take(50).any(|(_, f)| {
             matches!(
                 decode_frame(f.id(), f.data()).map(|d| d.message),
                 Ok(AnyMessage::ControllerStatus(s)) if s.mode == ControllerMode::WheelForward
             )
-        });
-    }
+        })
+    });
     assert!(driving, "the robot never drove forward");
     let latch = AnyMessage::EStop(EStop {
         action: EStopAction::Latch,
@@ -230,12 +228,9 @@ fn a_teleop_command_from_cansend_folds_the_robot_onto_its_wheels() {
     // Lockstep, paced to real time at most, so that a shell command lands in time.
     let sim = start_sim(bus.name(), &out, &["--duration", "8", "--pace", "1"]);
     // Once the controller reports (it stands in Stop), send `fold` from a shell.
-    let started = Instant::now();
-    let mut up = false;
-    while !up && started.elapsed() < Duration::from_secs(120) {
-        std::thread::sleep(Duration::from_millis(20));
-        up = read_candump(&log).iter().any(|(_, f)| f.id() == 0x400);
-    }
+    let up = wait_for_log(&log, Duration::from_secs(120), |frames| {
+        frames.iter().any(|(_, f)| f.id() == 0x400)
+    });
     assert!(up, "the controller never reported");
     let fold = AnyMessage::TeleopCommand(protocol::TeleopCommand {
         mode: protocol::TeleopMode::Fold,
@@ -275,12 +270,9 @@ fn teleop_send_from_a_script_folds_the_robot_and_the_controller_stops_when_it_qu
     let dump = candump(&bus, &log);
     let out = out_dir("script");
     let sim = start_sim(bus.name(), &out, &["--duration", "8", "--pace", "1"]);
-    let started = Instant::now();
-    let mut up = false;
-    while !up && started.elapsed() < Duration::from_secs(120) {
-        std::thread::sleep(Duration::from_millis(20));
-        up = read_candump(&log).iter().any(|(_, f)| f.id() == 0x400);
-    }
+    let up = wait_for_log(&log, Duration::from_secs(120), |frames| {
+        frames.iter().any(|(_, f)| f.id() == 0x400)
+    });
     assert!(up, "the controller never reported");
     let teleop = Process::start("teleop", &["--bus", bus.name(), "send", "F", "--for", "2"]);
     assert!(
