@@ -16,9 +16,9 @@ use sim_host::lockstep::{self, LockstepOptions};
 use sim_host::model::DEFAULT_MODEL;
 use sim_host::physics::Physics;
 use sim_host::recorder::Recorder;
-use sim_host::scripted_teleop::{PlanStep, ScriptedTeleop};
 use sim_host::session::firmware_config;
 use sim_host::simulator::{Simulator, StartPose};
+use teleop_core::scripted::{PlanStep, ScriptedTeleop};
 
 fn raw_step(c: &mut Criterion) {
     let mut physics = Physics::load(Path::new(DEFAULT_MODEL)).expect("model");

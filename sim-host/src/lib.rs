@@ -26,8 +26,6 @@ pub mod recorder;
 #[cfg(feature = "renderer")]
 pub mod render;
 pub mod run_stats;
-pub mod scenario;
-pub mod scripted_teleop;
 pub mod session;
 pub mod simulator;
 pub mod summary;

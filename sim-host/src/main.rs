@@ -12,10 +12,10 @@ use clap::{Parser, Subcommand, ValueEnum};
 use protocol::TeleopMode;
 use sim_host::imu::ImuNoise;
 use sim_host::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
-use sim_host::scenario::{mode_name, Scenario};
-use sim_host::scripted_teleop::PlanStep;
 use sim_host::session::{self, BusChoice, Clock, FrameSettings, SegmentSpec, SessionConfig};
 use sim_host::summary::{self, Summary};
+use teleop_core::scenario::{mode_name, Scenario};
+use teleop_core::scripted::PlanStep;
 
 /// The hybrid wheel–leg robot in MuJoCo, on a CAN bus.
 ///
@@ -253,6 +253,7 @@ fn run(args: RunArgs) -> Result<(), String> {
             ..ImuNoise::default()
         },
         teleop_plan,
+        attach: None,
         out_dir: Some(args.out.clone()),
         plots: !args.no_plots,
         progress: !args.no_progress,

@@ -7,7 +7,7 @@ use std::num::NonZeroU32;
 use std::path::PathBuf;
 use std::rc::Rc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use indicatif::{ProgressBar, ProgressStyle};
@@ -21,12 +21,12 @@ use crate::output_error::OutputError;
 use crate::realtime::{self, RealtimeOptions};
 use crate::recorder::Recorder;
 use crate::run_stats::{RunError, RunStats};
-use crate::scripted_teleop::{PlanStep, ScriptedTeleop};
 use crate::simulator::{Simulator, StartPose};
 use crate::telemetry::TelemetryRow;
 use firmware_host::bus::{Bus, BusError};
 use firmware_host::inproc_bus::InprocBus;
 use firmware_host::socketcan_bus::SocketCanBus;
+use teleop_core::scripted::{PlanStep, ScriptedTeleop};
 
 /// Which bus the simulator joins.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -91,6 +91,19 @@ pub struct SessionConfig {
     /// Open the MuJoCo viewer, synced every cycle, and keep it open after the run until it is
     /// closed (closing it early ends the run). Without the `viewer` feature, `true` is an error.
     pub viewer: bool,
+    /// Someone outside the session on the in-process bus (the interactive teleop), or `None`.
+    pub attach: Option<Attach>,
+}
+
+/// An outside node's link to an in-process session: the session joins `bus` instead of making
+/// its own, and publishes its latest telemetry row (ground truth) in `live` every 10 cycles.
+/// Without an output folder the session then keeps no rows, so it can run for hours.
+#[derive(Debug, Clone, Default)]
+pub struct Attach {
+    /// The bus the outside node is on.
+    pub bus: InprocBus,
+    /// The latest telemetry row, `None` until the first.
+    pub live: Arc<Mutex<Option<TelemetryRow>>>,
 }
 
 /// Where a segment of the run starts and what it is called.
@@ -191,6 +204,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
             files.push(log.clone());
             Recorder::with_candump(&log, &interface)?
         }
+        None if config.attach.is_some() => Recorder::discarding(),
         None => Recorder::in_memory(),
     };
     let mut watch = Watch::open(config, &sim)?;
@@ -242,6 +256,15 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         if u64::from(s.cycle()) % 25 == 0 {
             progress.set_position(u64::from(s.cycle()));
         }
+        if let Some(attach) = &config.attach {
+            if s.cycle() % 10 == 0 {
+                let mut live = attach
+                    .live
+                    .lock()
+                    .unwrap_or_else(|poisoned| poisoned.into_inner());
+                *live = Some(s.telemetry());
+            }
+        }
         if config
             .stop
             .as_ref()
@@ -261,7 +284,10 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
 
     let (stats, firmware_rejected) = match &config.bus {
         BusChoice::Inproc => {
-            let bus = InprocBus::new();
+            let bus = config
+                .attach
+                .as_ref()
+                .map_or_else(InprocBus::new, |a| a.bus.clone());
             let mut sim_bus = bus.endpoint();
             let firmware = firmware_config(config.control_hz)
                 .ok_or(SessionError::ControlRate(config.control_hz))?;

@@ -8,9 +8,9 @@ use std::time::Duration;
 use sim_host::imu::ImuNoise;
 use sim_host::metrics::SegmentSummary;
 use sim_host::model::DEFAULT_MODEL;
-use sim_host::scenario::{mode_name, Scenario};
-use sim_host::scripted_teleop::PlanStep;
 use sim_host::session::{self, BusChoice, Clock, SegmentSpec, SessionConfig};
+use teleop_core::scenario::{mode_name, Scenario};
+use teleop_core::scripted::PlanStep;
 
 fn scenario_file(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -20,6 +20,7 @@ fn scenario_file(name: &str) -> PathBuf {
 
 fn config(plan: Vec<PlanStep>, segments: Vec<SegmentSpec>, duration_s: f64) -> SessionConfig {
     SessionConfig {
+        attach: None,
         model: PathBuf::from(DEFAULT_MODEL),
         bus: BusChoice::Inproc,
         clock: Clock::Lockstep,
@@ -71,7 +72,7 @@ fn plan(steps: &[(f64, &str)]) -> (Vec<PlanStep>, Vec<SegmentSpec>) {
         .iter()
         .map(|(at_s, mode)| PlanStep {
             at_us: (at_s * 1e6) as u64,
-            mode: sim_host::scenario::parse_mode(mode).unwrap(),
+            mode: teleop_core::scenario::parse_mode(mode).unwrap(),
             body_height_m: 0.0,
             speed_scale_pct: 100.0,
         })

@@ -1,12 +1,16 @@
-//! Teleop over CAN: what an operator's keys mean ([`keys`]) and what the operator node puts on
-//! the bus ([`operator`]) — the teleop command on every change and at 50 Hz, the heartbeat at
-//! 50 Hz, E-stop latch and clear. Sans-IO: time comes in as milliseconds, frames go out as
-//! values; the terminal UI and the bus live at the edge. [`bus_status`] is what the operator
-//! sees of the robot, read off the bus.
+//! The `teleop` program: an operator drives the robot over CAN from a terminal (the report's
+//! keys W/S/A/L/K/X, stand, fold, height, speed, E-stop) or from a script, on a SocketCAN bus
+//! or, with the `sim` feature, on an in-process bus with the simulated robot beside it.
+//!
+//! The operator itself is sans-IO ([`teleop_core`]); this crate is its edge: [`app`] (the
+//! interactive state), [`ui`] (the screen), [`terminal`] (keys and screen on a real terminal),
+//! [`script`] (`send` and `script` on the wall clock), [`inproc`] (the simulated robot).
 
 #![deny(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
-#![cfg_attr(test, allow(clippy::unwrap_used, clippy::expect_used, clippy::panic))]
 
-pub mod bus_status;
-pub mod keys;
-pub mod operator;
+pub mod app;
+#[cfg(feature = "sim")]
+pub mod inproc;
+pub mod script;
+pub mod terminal;
+pub mod ui;

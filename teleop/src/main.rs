@@ -1,28 +1,48 @@
-//! `teleop`: drive the robot over CAN. Scripted mode (`send`) for shells and automation; the
-//! interactive terminal UI follows.
+//! `teleop`: drive the robot over CAN from a terminal or a script.
 
+use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::{Duration, Instant};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
 
 use clap::{Parser, Subcommand};
 use firmware_host::bus::Bus;
 use firmware_host::socketcan_bus::SocketCanBus;
-use teleop::keys::{action, Action, Key};
-use teleop::operator::Operator;
+use teleop::script::{self, ScriptReport};
+use teleop_core::keys::{action, Action, Key};
+use teleop_core::scenario::{mode_name, Scenario};
 
 /// Drive the hybrid wheel–leg robot over CAN with the report's keys.
 ///
-/// Example: teleop --bus vcan0 send W --for 5
-/// (holds W for 5 s with the heartbeat going; the controller stops the robot within 500 ms of
-/// the last heartbeat).
+/// Without a subcommand teleop opens its terminal UI: W/S wheels forward/backward, A rotate,
+/// L/K trot forward/backward, X stop, T stand, F fold, ↑/↓ body height, ]/[ speed, space
+/// E-stop (R twice releases it), Q quit. It sends the operator's heartbeat at 50 Hz; when
+/// teleop quits or dies the controller stops the robot within 500 ms.
+///
+/// Examples:
+///   teleop --bus inproc                 drive the simulated robot (no CAN needed)
+///   teleop --bus vcan0                  drive whatever controller is on vcan0
+///   teleop --bus vcan0 send W --for 5   hold W for 5 s (for scripts)
+///   teleop --bus vcan0 script scenarios/acceptance/w.toml
+///
+/// Exit codes: 0 done, 1 the bus or the simulator failed, 2 bad arguments or scenario file,
+/// 3 no controller answered on the bus.
 #[derive(Debug, Parser)]
-#[command(version, about, long_about)]
+#[command(version, about, long_about, verbatim_doc_comment)]
 struct Cli {
-    /// The SocketCAN interface (vcan0, can0).
+    /// The bus: a SocketCAN interface (vcan0, can0) or `inproc` (the simulator and the
+    /// firmware in this process, on the wall clock).
     #[arg(long, default_value = "vcan0")]
     bus: String,
+    /// With `--bus inproc`: the MJCF model (default: the report's robot on flat ground).
+    #[arg(long)]
+    model: Option<PathBuf>,
+    /// With `--bus inproc`: write telemetry.csv, bus.log and plots here when teleop ends.
+    #[arg(long)]
+    out: Option<PathBuf>,
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
 }
 
 #[derive(Debug, Subcommand)]
@@ -36,67 +56,214 @@ enum Command {
         #[arg(long = "for", default_value_t = 1.0)]
         seconds: f64,
     },
+    /// Follow a scenario file (TOML: steps of `at_s` and `mode`, as sim-host reads) on the
+    /// wall clock.
+    Script {
+        /// The scenario file, e.g. scenarios/report_demo.toml.
+        file: PathBuf,
+    },
 }
 
 fn parse_key(text: &str) -> Result<Action, String> {
-    let key = match text {
-        "space" => ' ',
-        _ if text.chars().count() == 1 => text.chars().next().unwrap_or(' '),
-        _ => {
-            return Err(format!(
-                "`{text}`: give one key: W S A L K X T F, or `space`"
-            ))
-        }
+    let wrong = || format!("`{text}`: give one key: W S A L K X T F, or `space`");
+    let mut chars = text.chars();
+    let key = match (text, chars.next(), chars.next()) {
+        ("space", _, _) => ' ',
+        (_, Some(c), None) => c,
+        _ => return Err(wrong()),
     };
     match action(Key::Char(key)) {
         Some(a @ (Action::Mode(_) | Action::EStop)) => Ok(a),
-        _ => Err(format!(
-            "`{text}`: give one key: W S A L K X T F, or `space`"
-        )),
+        _ => Err(wrong()),
+    }
+}
+
+/// A failure, with the exit code a shell can act on.
+struct Failure {
+    code: u8,
+    message: String,
+}
+
+impl Failure {
+    fn bus(e: impl std::fmt::Display) -> Self {
+        Self {
+            code: 1,
+            message: e.to_string(),
+        }
+    }
+
+    fn usage(message: String) -> Self {
+        Self { code: 2, message }
     }
 }
 
 fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+        )
+        .with_writer(std::io::stderr)
+        .init();
     let cli = Cli::parse();
-    let Command::Send { key, seconds } = cli.command;
-    if !(seconds.is_finite() && (0.0..=86_400.0).contains(&seconds)) {
-        eprintln!("teleop: --for {seconds}: give 0…86400 seconds");
-        return ExitCode::from(2);
-    }
-    let mut bus = match SocketCanBus::open(&cli.bus) {
-        Ok(bus) => bus,
-        Err(e) => {
-            eprintln!("teleop: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
-    match send(&mut bus, key, Duration::from_secs_f64(seconds)) {
-        Ok(frames) => {
-            println!("teleop: sent {frames} frames on {}", cli.bus);
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("teleop: {e}");
-            ExitCode::FAILURE
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(failure) => {
+            eprintln!("teleop: {}", failure.message);
+            ExitCode::from(failure.code)
         }
     }
 }
 
-/// Presses `key` and keeps the command and heartbeat going for `hold`; frames sent.
-fn send(bus: &mut dyn Bus, key: Action, hold: Duration) -> Result<u64, String> {
-    let start = Instant::now();
-    let mut operator = Operator::new();
-    operator.press(0, key);
-    let mut sent = 0;
-    loop {
-        let now_ms = u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX);
-        for frame in operator.poll(now_ms).map_err(|e| format!("{e:?}"))? {
-            bus.send(&frame).map_err(|e| e.to_string())?;
-            sent += 1;
-        }
-        if start.elapsed() >= hold {
-            return Ok(sent);
-        }
-        std::thread::sleep(Duration::from_millis(2));
+fn run(cli: Cli) -> Result<(), Failure> {
+    let stop = Arc::new(AtomicBool::new(false));
+    {
+        let stop = Arc::clone(&stop);
+        ctrlc::set_handler(move || stop.store(true, Ordering::Relaxed))
+            .map_err(|e| Failure::bus(format!("cannot install the Ctrl-C handler: {e}")))?;
     }
+    // Check what can be checked before the bus or the simulator starts.
+    let scenario = match &cli.command {
+        Some(Command::Script { file }) => {
+            Some(Scenario::load(file).map_err(|e| Failure::usage(e.to_string()))?)
+        }
+        Some(Command::Send { seconds, .. })
+            if !(seconds.is_finite() && (0.0..=86_400.0).contains(seconds)) =>
+        {
+            return Err(Failure::usage(format!(
+                "--for {seconds}: give 0…86400 seconds"
+            )))
+        }
+        _ => None,
+    };
+    if cli.bus == "inproc" {
+        return inproc(&cli, scenario.as_ref(), &stop);
+    }
+    if cli.model.is_some() || cli.out.is_some() {
+        return Err(Failure::usage(
+            "--model and --out belong to --bus inproc (on a CAN bus the robot is elsewhere)".into(),
+        ));
+    }
+    let mut bus = SocketCanBus::open(&cli.bus).map_err(Failure::bus)?;
+    operate(&mut bus, &cli, scenario.as_ref(), &stop, &mut || None)
+}
+
+/// Runs the chosen mode on `bus`; `live` gives ground truth when the robot is simulated here.
+fn operate(
+    bus: &mut dyn Bus,
+    cli: &Cli,
+    scenario: Option<&Scenario>,
+    stop: &AtomicBool,
+    live: &mut dyn FnMut() -> Option<teleop::app::SimView>,
+) -> Result<(), Failure> {
+    let report = match (&cli.command, scenario) {
+        (None, _) => {
+            let report = teleop::terminal::run(bus, &cli.bus, live, stop)
+                .map_err(|e| Failure::bus(e.to_string()))?;
+            println!(
+                "teleop: sent {} frames on {}; the robot was told to stop{}",
+                report.frames_sent,
+                cli.bus,
+                if report.estop_latched {
+                    " (the E-stop is still latched)"
+                } else {
+                    ""
+                }
+            );
+            return Ok(());
+        }
+        (Some(Command::Send { key, seconds }), _) => {
+            script::send(bus, *key, Duration::from_secs_f64(*seconds), stop)
+        }
+        (Some(Command::Script { .. }), Some(scenario)) => {
+            println!(
+                "teleop: script `{}`, {} steps over {:.1} s on {}",
+                scenario.name,
+                scenario.steps.len(),
+                scenario.duration_s,
+                cli.bus
+            );
+            script::run(bus, scenario, stop, |index| {
+                if let Some(step) = scenario.steps.get(index) {
+                    println!(
+                        "  t = {:6.2} s  {:<5} {}",
+                        step.plan.at_us as f64 / 1e6,
+                        mode_name(step.plan.mode),
+                        step.label
+                    );
+                }
+            })
+        }
+        (Some(Command::Script { .. }), None) => {
+            return Err(Failure::usage("the scenario was not loaded".into()))
+        }
+    }
+    .map_err(Failure::bus)?;
+    conclude(&report, &cli.bus)
+}
+
+fn conclude(report: &ScriptReport, bus: &str) -> Result<(), Failure> {
+    println!(
+        "teleop: sent {} frames on {bus}, heard {}{}",
+        report.frames_sent,
+        report.frames_heard,
+        if report.interrupted {
+            " (interrupted)"
+        } else {
+            ""
+        }
+    );
+    match report.last_mode {
+        Some(mode) => {
+            println!("teleop: the controller's last mode: {}", mode.label());
+            Ok(())
+        }
+        None => Err(Failure {
+            code: 3,
+            message: format!(
+                "no controller status was heard on {bus}: is the firmware running there \
+                 (firmware-host --bus {bus})? Or use --bus inproc for the simulated robot."
+            ),
+        }),
+    }
+}
+
+#[cfg(feature = "sim")]
+fn inproc(cli: &Cli, scenario: Option<&Scenario>, stop: &AtomicBool) -> Result<(), Failure> {
+    use teleop::inproc::{InprocOptions, InprocRobot};
+    let mut options = InprocOptions::realtime();
+    if let Some(model) = &cli.model {
+        options.model = model.clone();
+    }
+    options.out_dir = cli.out.clone();
+    let (robot, mut endpoint) = InprocRobot::start(options);
+    // A simulator that fails (a bad model, say) ends the session; its error is shown below.
+    let mut live = || {
+        if robot.finished() {
+            stop.store(true, Ordering::Relaxed);
+        }
+        robot.view()
+    };
+    let result = operate(&mut endpoint, cli, scenario, stop, &mut live);
+    let last = robot.view();
+    let finished = robot.finish();
+    result?;
+    let report = finished.map_err(|e| Failure::bus(sim_host::error_chain::chain(&e)))?;
+    if let Some(v) = last {
+        println!(
+            "teleop: the simulated robot ended at x {:+.2} m, y {:+.2} m, heading {:+.0}°",
+            v.position_m[0], v.position_m[1], v.yaw_deg
+        );
+    }
+    for file in &report.files {
+        println!("teleop: wrote {}", file.display());
+    }
+    Ok(())
+}
+
+#[cfg(not(feature = "sim"))]
+fn inproc(_: &Cli, _: Option<&Scenario>, _: &AtomicBool) -> Result<(), Failure> {
+    Err(Failure::usage(
+        "--bus inproc needs teleop built with its `sim` feature (the default)".into(),
+    ))
 }

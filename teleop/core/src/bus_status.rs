@@ -26,6 +26,8 @@ pub struct BusStatus {
 impl BusStatus {
     /// Takes a frame seen at `now_ms`.
     pub fn observe(&mut self, now_ms: u64, frame: &Frame) {
+        let start = now_ms.saturating_sub(RATE_WINDOW_MS);
+        self.window.retain(|t| *t > start);
         self.window.push(now_ms);
         let Ok(decoded) = decode_frame(frame.id(), frame.data()) else {
             self.undecodable += 1;
@@ -69,6 +71,18 @@ impl BusStatus {
             .is_none_or(|t| now_ms.saturating_sub(t) > SILENT_MS)
     }
 
+    /// Milliseconds since the drives' last feedback, `None` before the first.
+    pub fn feedback_age_ms(&self, now_ms: u64) -> Option<u64> {
+        self.last_feedback_ms.map(|t| now_ms.saturating_sub(t))
+    }
+
+    /// Milliseconds since the controller's last status, `None` before the first.
+    pub fn controller_age_ms(&self, now_ms: u64) -> Option<u64> {
+        self.controller
+            .as_ref()
+            .map(|(t, _)| now_ms.saturating_sub(*t))
+    }
+
     /// Wheel speeds, left and right, rad/s.
     pub fn wheel_speed_rad_s(&self) -> Option<[f32; 2]> {
         self.wheel_speed_rad_s.map(|(_, s)| s)
@@ -90,10 +104,10 @@ impl BusStatus {
     }
 
     /// Frames per second over the last [`RATE_WINDOW_MS`].
-    pub fn frames_per_s(&mut self, now_ms: u64) -> f64 {
+    pub fn frames_per_s(&self, now_ms: u64) -> f64 {
         let start = now_ms.saturating_sub(RATE_WINDOW_MS);
-        self.window.retain(|t| *t > start);
-        self.window.len() as f64 * 1_000.0 / RATE_WINDOW_MS as f64
+        let recent = self.window.iter().filter(|t| **t > start).count();
+        recent as f64 * 1_000.0 / RATE_WINDOW_MS as f64
     }
 }
 

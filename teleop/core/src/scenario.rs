@@ -23,7 +23,7 @@ use protocol::TeleopMode;
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::scripted_teleop::PlanStep;
+use crate::scripted::PlanStep;
 
 /// One operator command and the segment it starts.
 #[derive(Debug, Clone, PartialEq)]
