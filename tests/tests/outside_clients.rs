@@ -5,7 +5,7 @@ use std::time::Duration;
 
 use hil_tests::{
     candump, cansend, firmware, out_dir, read_candump, read_telemetry, start_sim, wait_for_log,
-    Process, Vcan,
+    workspace, Process, Vcan,
 };
 use protocol::{decode_frame, AnyMessage, ControllerMode, EStop, EStopAction, NodeId};
 
@@ -320,4 +320,47 @@ fn teleop_send_from_a_script_folds_the_robot_and_the_controller_stops_when_it_qu
         "reported after {:.3} s",
         noticed - last_beat
     );
+}
+
+#[test]
+fn teleop_script_drives_the_robot_and_a_bus_without_controller_exits_3() {
+    let bus = Vcan::new();
+    let fw = firmware(&bus);
+    let log = out_dir("teleop-script-dump").with_extension("log");
+    let dump = candump(&bus, &log);
+    let out = out_dir("teleop-script");
+    let sim = start_sim(bus.name(), &out, &["--duration", "10", "--pace", "1"]);
+    let up = wait_for_log(&log, Duration::from_secs(120), |frames| {
+        frames.iter().any(|(_, f)| f.id() == 0x400)
+    });
+    assert!(up, "the controller never reported");
+    let script = workspace().join("scenarios/teleop_drive.toml");
+    let teleop = Process::start(
+        "teleop",
+        &["--bus", bus.name(), "script", &script.to_string_lossy()],
+    );
+    let status = teleop.wait(Duration::from_secs(60));
+    assert!(status.success(), "teleop script failed: {status}");
+    assert!(sim.wait(Duration::from_secs(600)).success());
+    let _ = fw.terminate();
+    let _ = dump.terminate();
+    let rows = read_telemetry(&out.join("telemetry.csv"));
+    assert!(
+        rows.iter().any(|(.., mode)| mode == "WheelForward"),
+        "never drove forward"
+    );
+    let text = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    let last = text.lines().last().unwrap().to_owned();
+    let x: f64 = last.split(',').nth(1).unwrap().parse().unwrap();
+    println!("teleop script: the robot drove {x:.2} m");
+    assert!(x > 0.2, "the robot drove {x:.2} m");
+
+    // Nobody on the bus: a shell user learns there is no controller (exit 3).
+    let empty = Vcan::new();
+    let lonely = Process::start(
+        "teleop",
+        &["--bus", empty.name(), "send", "W", "--for", "0.5"],
+    );
+    let status = lonely.wait(Duration::from_secs(30));
+    assert_eq!(status.code(), Some(3), "{status}");
 }

@@ -4,6 +4,11 @@
 //! with the firmware's control core on the in-process CAN bus (or over SocketCAN with `--bus`).
 //! Leaves `summary.json`, `telemetry.csv`, `bus.log` (candump), the plots and a few rendered
 //! frames in `out/` and prints a table of the segments.
+//!
+//! `cargo xtask demo --teleop` instead opens teleop's terminal UI on the simulated robot: the
+//! simulator and the firmware run in the teleop process on the in-process bus, so anyone can
+//! drive the robot with the report's keys without a CAN interface. The run's telemetry, bus log
+//! and plots land in `out/teleop/` when teleop quits.
 
 use crate::util::{cargo, root, run as sh};
 
@@ -12,6 +17,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
     let mut out = root().join("out");
     let mut scenario = root().join("scenarios").join("report_demo.toml");
     let mut render = true;
+    let mut teleop = false;
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         let mut value = |name: &str| {
@@ -24,14 +30,29 @@ pub fn run(args: &[String]) -> Result<(), String> {
             "--out" => out = value("--out")?.into(),
             "--scenario" => scenario = value("--scenario")?.into(),
             "--no-render" => render = false,
+            "--teleop" => teleop = true,
             other => {
                 return Err(format!(
-                    "unknown option `{other}`: use --bus IFNAME, --out DIR, --scenario FILE, --no-render"
+                    "unknown option `{other}`: use --bus IFNAME, --out DIR, --scenario FILE, --no-render, --teleop"
                 ))
             }
         }
     }
     crate::setup::run()?;
+    if teleop {
+        if bus != "inproc" {
+            return Err(format!(
+                "--teleop drives the in-process robot; for {bus} run firmware-host and sim-host \
+                 there and then `cargo run --release -p teleop -- --bus {bus}`"
+            ));
+        }
+        let out = out.join("teleop");
+        sh(cargo()
+            .args(["run", "--release", "--quiet", "-p", "teleop", "--"])
+            .args(["--bus", "inproc", "--out"])
+            .arg(&out))?;
+        return Ok(());
+    }
     let mut cmd = cargo();
     cmd.args(["run", "--release", "--quiet", "-p", "sim-host"]);
     if render {

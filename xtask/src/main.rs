@@ -37,6 +37,8 @@ Tasks:
                      CAN bus; writes out/ (summary.json, telemetry.csv, bus.log, plots, frames)
                      --bus vcan0   over SocketCAN instead (the controller runs elsewhere)
                      --out DIR     --scenario FILE     --no-render (skip the rendered frames)
+                     --teleop      drive it yourself instead: teleop's terminal UI on the
+                                   simulated robot (keys W S A L K X, T, F, space, Q)
 ";
 
 fn main() -> ExitCode {

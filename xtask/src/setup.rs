@@ -4,7 +4,8 @@
 //! - a project-local Python venv (`.venv/`) with the pinned `cantools`, used by the tests that
 //!   read the bus with standard tools, and pip's `download` for MuJoCo;
 //! - the MuJoCo library in `.cache/mujoco/` ([`crate::mujoco`]);
-//! - Mesa's EGL for headless rendering, from apt ([`crate::apt`]).
+//! - Mesa's EGL for headless rendering and tmux for the teleop terminal test, from apt
+//!   ([`crate::apt`]).
 //!
 //! Nothing is installed system-wide.
 
@@ -29,6 +30,7 @@ pub fn run() -> Result<(), String> {
         &crate::apt::RENDERING,
         "headless rendering (sim-host --features renderer)",
     )?;
+    crate::apt::ensure(&["tmux"], "the teleop terminal test (teleop/tests/tmux.rs)")?;
     eprintln!("setup: done");
     Ok(())
 }
