@@ -48,7 +48,9 @@ pub struct Config {
     pub feedback_timeout_ms: u32,
     /// IMU samples older than this stop a balancing robot, ms.
     pub imu_timeout_ms: u32,
-    /// An operator silent this long is treated as a stop request, ms.
+    /// An operator silent this long is treated as a stop request, ms. 460 ms so that the robot
+    /// is stopped within 500 ms of teleop dying: its last heartbeat may have gone out up to one
+    /// 20 ms period before, and the watchdog acts on the next 4 ms tick.
     pub teleop_timeout_ms: u32,
     /// Pitch or roll beyond this is a fall: fault, rad.
     pub tilt_limit_rad: f32,
@@ -85,7 +87,7 @@ impl Config {
         },
         feedback_timeout_ms: 50,
         imu_timeout_ms: 50,
-        teleop_timeout_ms: 500,
+        teleop_timeout_ms: 460,
         tilt_limit_rad: crate::math::deg_to_rad(45.0),
     };
 

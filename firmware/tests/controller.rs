@@ -253,7 +253,7 @@ fn silent_feedback_safe_stops_within_fifty_milliseconds() {
 }
 
 #[test]
-fn a_silent_operator_stops_the_robot_after_half_a_second() {
+fn a_silent_operator_stops_the_robot_within_half_a_second_of_teleop_dying() {
     let mut bench = Bench::new();
     bench.run(5);
     bench.send(command(TeleopMode::TrotForward));
@@ -271,7 +271,7 @@ fn a_silent_operator_stops_the_robot_after_half_a_second() {
     }
     let silent_ms = ticks * 4;
     assert!(
-        (500..=508).contains(&silent_ms),
+        (460..=468).contains(&silent_ms),
         "stopped {silent_ms} ms after the last heartbeat"
     );
     assert_eq!(bench.state(), State::Legs(LegMotion::Stand));

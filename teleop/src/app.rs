@@ -96,7 +96,7 @@ impl App {
     }
 
     /// The frames that stop the robot when the operator leaves: a STOP command at once (the
-    /// controller would also stop on the lost heartbeat, 500 ms later).
+    /// controller would also stop on the lost heartbeat, 460 ms later).
     pub fn farewell(&mut self, now_ms: u64) -> Result<Vec<Frame>, EncodeError> {
         self.operator
             .press(now_ms, Action::Mode(protocol::TeleopMode::Stop));
