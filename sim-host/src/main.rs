@@ -154,13 +154,7 @@ fn parse_step(text: &str) -> Result<PlanStep, String> {
 }
 
 fn main() -> ExitCode {
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env()
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
-        )
-        .with_writer(std::io::stderr)
-        .init();
+    firmware_host::logging::init("info");
     let cli = Cli::parse();
     match cli.command {
         Command::Run(args) => match run(args) {

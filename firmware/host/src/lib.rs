@@ -7,5 +7,6 @@
 
 pub mod bus;
 pub mod inproc_bus;
+pub mod logging;
 pub mod runner;
 pub mod socketcan_bus;

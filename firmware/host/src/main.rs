@@ -47,13 +47,7 @@ enum ClockArg {
 }
 
 fn main() -> ExitCode {
-    tracing_subscriber::fmt()
-        .with_env_filter(
-            tracing_subscriber::EnvFilter::try_from_default_env()
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("info")),
-        )
-        .with_writer(std::io::stderr)
-        .init();
+    firmware_host::logging::init("info");
     let cli = Cli::parse();
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
