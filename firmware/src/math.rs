@@ -12,10 +12,10 @@
 //!
 //! `libm` is within 1–2 ulp for all of them. On the Cortex-M4F the hardware square root is
 //! exact (IEEE correctly rounded, 14 cycles) and far faster than `libm`'s software `sqrtf`,
-//! which this target would otherwise get. `libm::sinf`/`cosf` compute in `f64` (musl's kernels),
-//! which the M4F's single-precision FPU can only emulate in software: measured in the
-//! processor-in-the-loop run (`cargo xtask pil`), they made up most of a trot step's ~22,000
-//! instructions. [`sin_cos`] stays in `f32`: a Cody–Waite reduction by π/2 and Taylor series on
+//! which this target would otherwise get. `libm::sinf`/`cosf` compute in double precision
+//! (musl's kernels), which the M4F's single-precision FPU can only emulate in software: measured
+//! in the processor-in-the-loop run (`cargo xtask pil`), they made up half of a trot step's
+//! ~25,000 instructions (with [`sin_cos`]: ~11,000). [`sin_cos`] stays in `f32`: a Cody–Waite reduction by π/2 and Taylor series on
 //! ±π/4, within 2 ulp of `libm` for the angles the core uses (tested).
 
 /// `degrees` in radians (for readable constants).
