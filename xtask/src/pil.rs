@@ -770,6 +770,34 @@ mod tests {
         assert_eq!(Recording::from_raw(&recording.to_raw()).unwrap(), recording);
     }
 
+    fn wheel_command(left: i16, right: i16) -> Vec<u8> {
+        use protocol::{AnyMessage, Torque, WheelCommand};
+        let torque = [left, right].map(|raw| Torque::from_raw(raw).unwrap());
+        AnyMessage::WheelCommand(WheelCommand { torque })
+            .encode(3)
+            .unwrap()
+            .data()
+            .to_vec()
+    }
+
+    #[test]
+    fn a_difference_names_the_tick_and_the_field() {
+        let id = MessageId::WheelCommand.raw();
+        let mut check = Check::default();
+        let same = wheel_command(100, 200);
+        compare_frame(5, id, &same, &same, &mut check).unwrap();
+        assert_eq!((check.values, check.off_by_one), (2, 0));
+        compare_frame(6, id, &same, &wheel_command(100, 201), &mut check).unwrap();
+        assert_eq!(check.off_by_one, 1);
+        assert!(
+            check.max_at.contains("WheelCommand.torque_"),
+            "{}",
+            check.max_at
+        );
+        let error = compare_frame(7, id, &same, &wheel_command(100, 250), &mut check).unwrap_err();
+        assert!(error.starts_with("tick 7: WheelCommand.torque_"), "{error}");
+    }
+
     #[test]
     fn runs_cover_every_length() {
         for len in 0..300 {
