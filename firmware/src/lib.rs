@@ -8,7 +8,7 @@
 //!
 //! | layer | module | what it does |
 //! |---|---|---|
-//! | CAN node | [`node`] | frames in (decode, E2E, counted rejects), frames out on the bus schedule |
+//! | CAN node | [`node`], [`can`] | frames in (decode, E2E, counted rejects), frames out on the bus schedule |
 //! | control step | [`controller`] | supervisor → FSM → leg goals + smoothing → wheel law → clamps |
 //! | modes | [`fsm`] | states, events and the transition table |
 //! | legs | [`kinematics`], [`posture`], [`gait`], [`foot_trajectory`], [`sine_gait`], [`phase`], [`smoothing`] | IK/FK, stance and fold, the trot |
@@ -29,6 +29,7 @@ pub use protocol;
 
 pub mod attitude;
 pub mod balance;
+pub mod can;
 pub mod config;
 pub mod controller;
 pub mod foot_trajectory;

@@ -8,12 +8,15 @@
 //! | `sqrt`   | 6.1 % relative      | no             | FPU `vsqrt.f32` on the MCU, `libm` on host  |
 //! | `acos`   | 2.9e-2 rad (1.7°)   | no             | `libm::acosf`                              |
 //! | `atan2`  | 2.8e-3 rad (0.16°)  | no             | `libm::atan2f`                             |
-//! | `sin/cos`| 1.1e-3              | no (0.4 mm)    | `libm::sinf` / `libm::cosf`                 |
+//! | `sin/cos`| 1.1e-3              | no (0.4 mm)    | [`sin_cos`]: own, `f32` only               |
 //!
 //! `libm` is within 1–2 ulp for all of them. On the Cortex-M4F the hardware square root is
 //! exact (IEEE correctly rounded, 14 cycles) and far faster than `libm`'s software `sqrtf`,
-//! which this target would otherwise get; the trigonometric functions have no FPU instruction
-//! and come from `libm`.
+//! which this target would otherwise get. `libm::sinf`/`cosf` compute in double precision
+//! (musl's kernels), which the M4F's single-precision FPU can only emulate in software: measured
+//! in the processor-in-the-loop run (`cargo xtask pil`), they made up half of a trot step's
+//! ~25,000 instructions (with [`sin_cos`]: ~11,000). [`sin_cos`] stays in `f32`: a Cody–Waite reduction by π/2 and Taylor series on
+//! ±π/4, within 2 ulp of `libm` for the angles the core uses (tested).
 
 /// `degrees` in radians (for readable constants).
 pub const fn deg_to_rad(degrees: f32) -> f32 {
@@ -53,13 +56,54 @@ pub fn sqrt(x: f32) -> f32 {
 /// Sine of `x` radians.
 #[inline]
 pub fn sin(x: f32) -> f32 {
-    libm::sinf(x)
+    sin_cos(x).0
 }
 
 /// Cosine of `x` radians.
 #[inline]
 pub fn cos(x: f32) -> f32 {
-    libm::cosf(x)
+    sin_cos(x).1
+}
+
+/// Beyond this the single-precision reduction loses accuracy; `libm` takes over (never the
+/// case for the core's angles).
+const SIN_COS_REDUCE_MAX: f32 = 8192.0;
+
+/// Sine and cosine of `x` radians, in `f32` only. NaN or infinite input gives NaN.
+pub fn sin_cos(x: f32) -> (f32, f32) {
+    // π/2 in three parts: the first two have few significant bits, so `k × part` is exact for
+    // the quotients that occur here (|k| < 2^13).
+    const PIO2_1: f32 = 1.570_312_5;
+    const PIO2_2: f32 = 4.837_513e-4;
+    const PIO2_3: f32 = 7.549_79e-8;
+    if !x.is_finite() {
+        return (f32::NAN, f32::NAN);
+    }
+    if !(-SIN_COS_REDUCE_MAX..=SIN_COS_REDUCE_MAX).contains(&x) {
+        return (libm::sinf(x), libm::cosf(x));
+    }
+    // Nearest multiple of π/2.
+    let q = x * core::f32::consts::FRAC_2_PI;
+    let k = if q >= 0.0 {
+        (q + 0.5) as i32
+    } else {
+        (q - 0.5) as i32
+    };
+    let kf = k as f32;
+    let r = ((x - kf * PIO2_1) - kf * PIO2_2) - kf * PIO2_3;
+    let z = r * r;
+    // Taylor series; on |r| ≤ π/4 the first omitted terms are below 2e-9.
+    let s =
+        r + r * z * (-1.0 / 6.0 + z * (1.0 / 120.0 + z * (-1.0 / 5040.0 + z * (1.0 / 362_880.0))));
+    let c = 1.0
+        + z * (-0.5
+            + z * (1.0 / 24.0 + z * (-1.0 / 720.0 + z * (1.0 / 40_320.0 - z / 3_628_800.0))));
+    match k & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
 }
 
 /// Arc cosine, in 0…π. Input outside −1…1 gives NaN, so callers clamp first.
@@ -103,4 +147,27 @@ pub fn wrap_pi(angle_rad: f32) -> f32 {
         wrapped -= TAU;
     }
     wrapped
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Within 2 ulp of 1 (absolute) of `libm` on ±50 rad, and exact at zero.
+    #[test]
+    fn sin_cos_match_libm() {
+        let mut worst = 0.0_f32;
+        for i in -500_000_i32..=500_000_i32 {
+            let x = i as f32 * 1e-4;
+            let (s, c) = sin_cos(x);
+            worst = worst
+                .max((s - libm::sinf(x)).abs())
+                .max((c - libm::cosf(x)).abs());
+        }
+        assert!(worst <= 2.0 * f32::EPSILON, "worst {worst:e}");
+        assert_eq!(sin_cos(0.0), (0.0, 1.0));
+        assert!(sin_cos(f32::NAN).0.is_nan() && sin_cos(f32::INFINITY).1.is_nan());
+        let big = 1.0e6_f32;
+        assert_eq!(sin_cos(big), (libm::sinf(big), libm::cosf(big)));
+    }
 }

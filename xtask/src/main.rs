@@ -5,8 +5,11 @@ mod bench;
 mod busload;
 mod dbc;
 mod demo;
+mod elf;
+mod firmware;
 mod hil;
 mod mujoco;
+mod pil;
 mod setup;
 mod test;
 mod util;
@@ -22,8 +25,8 @@ Tasks:
                      when already done
   test               everything CI checks: fmt, clippy -D warnings (all features), DBC
                      freshness, no f64 in the no_std crates, all tests (the headless renderer's
-                     too), a thumbv7em-none-eabihf build of the no_std crates, and the vcan
-                     suite (`hil`)
+                     too), a thumbv7em-none-eabihf build of the no_std crates, the MCU
+                     images (`firmware`, `pil`), and the vcan suite (`hil`)
   dbc [--check]      regenerate protocol/hybrid_robot.dbc (--check: fail if the committed file is stale)
   busload            print the per-cycle frame schedule and the bus load at 250 Hz and 1 kHz
   bench [args]       criterion benchmarks (control step, raw MuJoCo step, closed-loop cycle), then a
@@ -32,6 +35,12 @@ Tasks:
   hil [--vm]         the vcan hardware-in-the-loop suite: firmware and simulator as two processes
                      on a kernel vcan; natively where this kernel has vcan and you are root,
                      otherwise (or with --vm) in a QEMU VM booting a stock Debian kernel
+  firmware           build the STM32G474 image (firmware/stm32, release + LTO) and print its flash
+                     and static RAM use (fails over 64 KiB flash or 16 KiB RAM)
+  pil [--record]     processor-in-the-loop: the control core on QEMU's mps2-an386 (Cortex-M4F)
+                     against recorded bus traffic; fails unless its frames equal the host
+                     build's; prints instructions per control step and peak stack
+                     (--record: rerun the closed loop and rewrite firmware/pil/recording.pil)
   demo [options]     the report's demonstration, closed loop (STOP, W, S, A, L, K, X): sets up,
                      builds, runs scenarios/report_demo.toml with the firmware on the in-process
                      CAN bus; writes out/ (summary.json, telemetry.csv, bus.log, plots, frames)
@@ -58,6 +67,8 @@ fn main() -> ExitCode {
         "bench" => bench::run_task(rest),
         "demo" => demo::run(rest),
         "hil" => hil::run(rest),
+        "firmware" => firmware::run(),
+        "pil" => pil::run(rest),
         "help" | "-h" | "--help" => {
             print!("{HELP}");
             Ok(())

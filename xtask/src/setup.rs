@@ -35,7 +35,7 @@ pub fn run() -> Result<(), String> {
     Ok(())
 }
 
-fn ensure_target() -> Result<(), String> {
+pub fn ensure_target() -> Result<(), String> {
     let installed = output(Command::new("rustup").args(["target", "list", "--installed"])).ok_or(
         "`rustup` is not available: install Rust with rustup (https://rustup.rs), then rerun `cargo xtask setup`",
     )?;

@@ -52,6 +52,26 @@ pub fn run() -> Result<(), String> {
         doc.args(["-p", krate]);
     }
     sh(&mut doc)?;
+    // The MCU images: clippy for their target (on the host they are stubs), the STM32 image
+    // built and sized, and processor-in-the-loop in QEMU against the host build.
+    let mut clippy = cargo();
+    clippy
+        .args([
+            "clippy",
+            "-p",
+            "firmware-stm32",
+            "-p",
+            "firmware-pil",
+            "--target",
+            MCU_TARGET,
+            "--",
+            "-D",
+            "warnings",
+        ])
+        .envs(crate::pil::prepare_build_env()?);
+    sh(&mut clippy)?;
+    crate::firmware::run()?;
+    crate::pil::run(&[])?;
     crate::hil::run(&[])?;
     eprintln!("test: all checks passed");
     Ok(())

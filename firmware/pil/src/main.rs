@@ -1,0 +1,38 @@
+//! Processor-in-the-loop: the control core on an emulated Cortex-M4F (QEMU `mps2-an386`),
+//! stepped through recorded bus traffic, reporting what it sends and what each step cost.
+//!
+//! `cargo xtask pil` generates this image's linker script and memory map (the AN386's 4 MiB ZBT
+//! SSRAM1 at 0x0000_0000 for code, 128 KiB — the STM32G474's RAM size — of ZBT SSRAM2/3 at
+//! 0x2000_0000 for data and stack), turns the committed recording into the input file embedded here
+//! (`PIL_INPUTS`), builds, runs QEMU with `-icount shift=0` and compares the frames with the
+//! host build's. Each tick the image gives the [`firmware::Node`] the frames recorded for it
+//! through [`firmware::can::receive`] and runs [`firmware::Node::poll`] — the same calls as the
+//! board image — timing both with SysTick, then prints (semihosting):
+//!
+//! ```text
+//! PIL-CAL <instructions> <systick ticks>   a calibration loop of known length
+//! PIL-BASE <systick ticks>                 the cost of reading the timer twice
+//! T <tick> <systick ticks>                 one control step: frames in, step, frames out
+//! F <id hex> <data hex>                    each frame the step sent
+//! PIL-STACK <bytes>                        peak stack (cortex-m-rt paints it at reset)
+//! PIL-END <ticks>
+//! ```
+#![cfg_attr(target_os = "none", no_std, no_main)]
+#![deny(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+
+#[cfg(target_os = "none")]
+mod image;
+#[cfg(target_os = "none")]
+mod inputs;
+#[cfg(target_os = "none")]
+mod line;
+
+#[cfg(not(target_os = "none"))]
+fn main() {
+    println!("firmware-pil is the processor-in-the-loop image: run it with `cargo xtask pil`");
+}

@@ -1,0 +1,112 @@
+//! Start-up, the control loop and the panic handler of the board.
+
+use core::panic::PanicInfo;
+
+use cortex_m_rt::entry;
+use firmware::can::{self, FdFrame};
+use firmware::{Config, Node, Tick};
+use stm32g4xx_hal::can::CanExt;
+use stm32g4xx_hal::gpio::GpioExt;
+use stm32g4xx_hal::pac;
+use stm32g4xx_hal::pwr::{PwrExt, VoltageScale};
+use stm32g4xx_hal::rcc::{
+    self, FdCanClockSource, PllConfig, PllMDiv, PllNMul, PllQDiv, PllRDiv, PllSrc, RccExt,
+};
+use stm32g4xx_hal::time::RateExtU32;
+
+use crate::port::FdcanPort;
+use crate::timer::ControlTimer;
+
+/// The core's configuration: the robot at its default control rate (250 Hz; the timer and the
+/// bus also carry 1 kHz, `Config::ROBOT.at_rate(TickRate::MCU_1_KHZ)`).
+const CONFIG: Config = Config::ROBOT;
+
+/// Frames taken from the receive FIFO per pass of the loop (the FIFO holds 3).
+const RX_PER_PASS: usize = 8;
+
+#[entry]
+fn main() -> ! {
+    let (Some(dp), Some(cp)) = (pac::Peripherals::take(), cortex_m::Peripherals::take()) else {
+        halt()
+    };
+    // 24 MHz crystal (NUCLEO-G474RE) → PLL: /6 ×80 = 320 MHz; R /2 = 160 MHz core (boost
+    // mode, above 150 MHz), Q /4 = 80 MHz FDCAN kernel clock.
+    let pwr = dp
+        .PWR
+        .constrain()
+        .vos(VoltageScale::Range1 { enable_boost: true })
+        .freeze();
+    let clocks = rcc::Config::pll()
+        .pll_cfg(PllConfig {
+            mux: PllSrc::HSE(24.MHz()),
+            m: PllMDiv::DIV_6,
+            n: PllNMul::MUL_80,
+            r: Some(PllRDiv::DIV_2),
+            q: Some(PllQDiv::DIV_4),
+            p: None,
+        })
+        .boost(true)
+        .fdcan_src(FdCanClockSource::PLLQ);
+    let mut rcc = dp.RCC.constrain().freeze(clocks, pwr);
+    let gpioa = dp.GPIOA.split(&mut rcc);
+    let rx = gpioa.pa11.into_alternate::<9>();
+    let tx = gpioa.pa12.into_alternate::<9>();
+    let Some(mut port) = FdcanPort::start(dp.FDCAN1.fdcan(tx, rx, &mut rcc)) else {
+        halt()
+    };
+    let Some(mut timer) = ControlTimer::start(cp.SYST, rcc.clocks.core_clk.raw(), CONFIG.rate)
+    else {
+        halt()
+    };
+    let Ok(mut node) = Node::new(CONFIG) else {
+        halt()
+    };
+    let mut now = Tick(0);
+    loop {
+        // Frames that arrive before tick `now` runs belong to it.
+        for _ in 0..RX_PER_PASS {
+            let Some(frame) = port.receive() else { break };
+            // Rejections are counted by the node and reported on the bus.
+            let _ = can::receive(&mut node, now, &frame);
+        }
+        if timer.due() {
+            let (_, frames) = node.poll(now);
+            for frame in &frames {
+                if let Some(out) = can::transmit::<FdFrame>(frame) {
+                    port.transmit(&out);
+                }
+            }
+            now = now.plus(1);
+        }
+    }
+}
+
+/// Stops here for good: the safe state of this controller is silence.
+fn halt() -> ! {
+    silence_fdcan();
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+/// A panic (a bug: overflow checks are on in release too) halts the controller instead of
+/// resetting it: the FDCAN is put into its init state, which cancels the queued frames and sends
+/// nothing more, and every drive goes torque-free by its own 100 ms command timeout — the
+/// designed safe state (legs limp, wheels unpowered). A reset would restart the core in its
+/// start-up mode under a robot that may be balancing on its wheels, and a bug that panics once
+/// would likely panic again; halted, the state stays for a debugger (`probe-rs attach`).
+#[panic_handler]
+fn panic(_info: &PanicInfo) -> ! {
+    cortex_m::interrupt::disable();
+    halt()
+}
+
+/// FDCAN1 into its init state and its pending transmissions cancelled.
+fn silence_fdcan() {
+    // SAFETY: runs only once the control loop has stopped for good (panic or failed start-up);
+    // nothing else touches the FDCAN from then on.
+    let fdcan = unsafe { &*pac::FDCAN1::ptr() };
+    fdcan.cccr().modify(|_, w| w.init().set_bit());
+    // SAFETY: any bit pattern is a valid cancellation request (one bit per TX buffer).
+    fdcan.txbcr().write(|w| unsafe { w.bits(0b111) });
+}
