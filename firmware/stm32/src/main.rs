@@ -8,7 +8,7 @@
 //! `stm32g4xx-hal` with the `fdcan` crate; [`port`] is the thin adapter between its frames and
 //! `embedded_can::Frame`, which is all the core sees of the bus.
 //!
-//! Build, size and flash: `cargo xtask firmware`; `cargo run --release -p firmware-stm32
+//! Build, size and flash: `cargo xtask firmware`; `cargo run --profile mcu -p firmware-stm32
 //! --target thumbv7em-none-eabihf` flashes a board through probe-rs (`.cargo/config.toml`).
 //! On the host this package is a stub that says so.
 #![cfg_attr(target_os = "none", no_std, no_main)]
