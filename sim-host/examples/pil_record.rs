@@ -27,9 +27,9 @@ use sim_host::lockstep::{self, LockstepOptions};
 use sim_host::model::DEFAULT_MODEL;
 use sim_host::recorder::Recorder;
 use sim_host::run_stats::RunError;
-use sim_host::scripted_teleop::{PlanStep, ScriptedTeleop};
 use sim_host::session::firmware_config;
 use sim_host::simulator::{Simulator, StartPose};
+use teleop_core::scripted::{PlanStep, ScriptedTeleop};
 
 const CONTROL_HZ: u32 = 250;
 
