@@ -7,6 +7,7 @@ mod dbc;
 mod demo;
 mod elf;
 mod firmware;
+mod fuzz;
 mod hil;
 mod mujoco;
 mod pil;
@@ -41,6 +42,9 @@ Tasks:
                      against recorded bus traffic; fails unless its frames equal the host
                      build's; prints instructions per control step and peak stack
                      (--record: rerun the closed loop and rewrite firmware/pil/recording.pil)
+  fuzz [--seconds N] libFuzzer (cargo fuzz, nightly; installed if missing) on the frame decoders,
+                     the receive path and the firmware's frame handler, N s each (default 60)
+                     from the committed seeds; fails on a crash (--seeds: rewrite the seeds)
   demo [options]     the report's demonstration, closed loop (STOP, W, S, A, L, K, X): sets up,
                      builds, runs scenarios/report_demo.toml with the firmware on the in-process
                      CAN bus; writes out/ (summary.json, telemetry.csv, bus.log, plots, frames)
@@ -69,6 +73,7 @@ fn main() -> ExitCode {
         "hil" => hil::run(rest),
         "firmware" => firmware::run(),
         "pil" => pil::run(rest),
+        "fuzz" => fuzz::run(rest),
         "help" | "-h" | "--help" => {
             print!("{HELP}");
             Ok(())

@@ -293,7 +293,7 @@ fn qemu(image: &std::path::Path) -> Result<String, String> {
 }
 
 /// Frames one control step sent: id and data.
-type Frames = Vec<(u16, Vec<u8>)>;
+pub type Frames = Vec<(u16, Vec<u8>)>;
 
 /// What the image printed.
 struct PilRun {
@@ -577,6 +577,15 @@ fn record() -> Result<(), String> {
         compact.len()
     );
     Ok(())
+}
+
+/// The committed recording's frames, tick by tick (the fuzz seeds come from them).
+pub fn recorded_ticks() -> Result<Vec<Frames>, String> {
+    let path = root().join(RECORDING);
+    let bytes = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let recording =
+        Recording::from_compact(&bytes).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(recording.ticks)
 }
 
 /// The frames the firmware received, tick by tick.
