@@ -218,20 +218,53 @@ fn canplayer_replays_a_recorded_teleop_session_and_the_robot_repeats_it() {
     );
 }
 
+/// A standing robot on its own vcan for an outside client: the firmware, candump recording the
+/// bus to `log`, and the simulator (outputs in `out`) in lockstep paced to real time at most, so
+/// that a shell command lands in time. Made once the controller reports.
+struct PacedRobot {
+    bus: Vcan,
+    fw: Process,
+    dump: Process,
+    sim: Process,
+    log: std::path::PathBuf,
+    out: std::path::PathBuf,
+}
+
+impl PacedRobot {
+    fn start(name: &str, seconds: &str) -> Self {
+        let bus = Vcan::new();
+        let fw = firmware(&bus);
+        let log = out_dir(&format!("{name}-dump")).with_extension("log");
+        let dump = candump(&bus, &log);
+        let out = out_dir(name);
+        let sim = start_sim(bus.name(), &out, &["--duration", seconds, "--pace", "1"]);
+        let up = wait_for_log(&log, Duration::from_secs(120), |frames| {
+            frames.iter().any(|(_, f)| f.id() == 0x400)
+        });
+        assert!(up, "the controller never reported");
+        Self {
+            bus,
+            fw,
+            dump,
+            sim,
+            log,
+            out,
+        }
+    }
+
+    /// Waits for the simulator's run to end, then stops the firmware and candump.
+    fn finish(self) -> (Vcan, std::path::PathBuf, std::path::PathBuf) {
+        assert!(self.sim.wait(Duration::from_secs(600)).success());
+        let _ = self.fw.terminate();
+        let _ = self.dump.terminate();
+        (self.bus, self.log, self.out)
+    }
+}
+
 #[test]
 fn a_teleop_command_from_cansend_folds_the_robot_onto_its_wheels() {
-    let bus = Vcan::new();
-    let fw = firmware(&bus);
-    let log = out_dir("teleop-dump").with_extension("log");
-    let dump = candump(&bus, &log);
-    let out = out_dir("teleop");
-    // Lockstep, paced to real time at most, so that a shell command lands in time.
-    let sim = start_sim(bus.name(), &out, &["--duration", "8", "--pace", "1"]);
     // Once the controller reports (it stands in Stop), send `fold` from a shell.
-    let up = wait_for_log(&log, Duration::from_secs(120), |frames| {
-        frames.iter().any(|(_, f)| f.id() == 0x400)
-    });
-    assert!(up, "the controller never reported");
+    let robot = PacedRobot::start("teleop", "8");
     let fold = AnyMessage::TeleopCommand(protocol::TeleopCommand {
         mode: protocol::TeleopMode::Fold,
         body_height: protocol::BodyHeight::saturating_from_si(0.0),
@@ -239,10 +272,8 @@ fn a_teleop_command_from_cansend_folds_the_robot_onto_its_wheels() {
     })
     .encode(0)
     .unwrap();
-    cansend(&bus, &fold);
-    assert!(sim.wait(Duration::from_secs(600)).success());
-    let _ = fw.terminate();
-    let _ = dump.terminate();
+    cansend(&robot.bus, &fold);
+    let (_bus, _log, out) = robot.finish();
     let rows = read_telemetry(&out.join("telemetry.csv"));
     assert!(
         rows.iter().any(|(.., mode)| mode == "Folding"),
@@ -264,24 +295,16 @@ fn a_teleop_command_from_cansend_folds_the_robot_onto_its_wheels() {
 
 #[test]
 fn teleop_send_from_a_script_folds_the_robot_and_the_controller_stops_when_it_quits() {
-    let bus = Vcan::new();
-    let fw = firmware(&bus);
-    let log = out_dir("script-dump").with_extension("log");
-    let dump = candump(&bus, &log);
-    let out = out_dir("script");
-    let sim = start_sim(bus.name(), &out, &["--duration", "8", "--pace", "1"]);
-    let up = wait_for_log(&log, Duration::from_secs(120), |frames| {
-        frames.iter().any(|(_, f)| f.id() == 0x400)
-    });
-    assert!(up, "the controller never reported");
-    let teleop = Process::start("teleop", &["--bus", bus.name(), "send", "F", "--for", "2"]);
+    let robot = PacedRobot::start("script", "8");
+    let teleop = Process::start(
+        "teleop",
+        &["--bus", robot.bus.name(), "send", "F", "--for", "2"],
+    );
     assert!(
         teleop.wait(Duration::from_secs(60)).success(),
         "teleop send failed"
     );
-    assert!(sim.wait(Duration::from_secs(600)).success());
-    let _ = fw.terminate();
-    let _ = dump.terminate();
+    let (_bus, log, out) = robot.finish();
     let rows = read_telemetry(&out.join("telemetry.csv"));
     assert!(
         rows.iter().any(|(.., mode)| mode == "Folding"),
@@ -324,26 +347,20 @@ fn teleop_send_from_a_script_folds_the_robot_and_the_controller_stops_when_it_qu
 
 #[test]
 fn teleop_script_drives_the_robot_and_a_bus_without_controller_exits_3() {
-    let bus = Vcan::new();
-    let fw = firmware(&bus);
-    let log = out_dir("teleop-script-dump").with_extension("log");
-    let dump = candump(&bus, &log);
-    let out = out_dir("teleop-script");
-    let sim = start_sim(bus.name(), &out, &["--duration", "10", "--pace", "1"]);
-    let up = wait_for_log(&log, Duration::from_secs(120), |frames| {
-        frames.iter().any(|(_, f)| f.id() == 0x400)
-    });
-    assert!(up, "the controller never reported");
+    let robot = PacedRobot::start("teleop-script", "10");
     let script = workspace().join("scenarios/teleop_drive.toml");
     let teleop = Process::start(
         "teleop",
-        &["--bus", bus.name(), "script", &script.to_string_lossy()],
+        &[
+            "--bus",
+            robot.bus.name(),
+            "script",
+            &script.to_string_lossy(),
+        ],
     );
     let status = teleop.wait(Duration::from_secs(60));
     assert!(status.success(), "teleop script failed: {status}");
-    assert!(sim.wait(Duration::from_secs(600)).success());
-    let _ = fw.terminate();
-    let _ = dump.terminate();
+    let (_bus, _log, out) = robot.finish();
     let rows = read_telemetry(&out.join("telemetry.csv"));
     assert!(
         rows.iter().any(|(.., mode)| mode == "WheelForward"),
