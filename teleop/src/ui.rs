@@ -86,10 +86,7 @@ fn banners(app: &App, now_ms: u64) -> Vec<Line<'static>> {
         ));
     }
     if app.status().controller_silent(now_ms) {
-        let age = app
-            .status()
-            .controller_age_ms(now_ms)
-            .map_or("never heard".to_owned(), |ms| format!("silent for {ms} ms"));
+        let age = silence(app.status().controller_age_ms(now_ms));
         lines.push(Line::styled(
             format!(
                 " CONTROLLER SILENT ({age}): is the firmware running on {}? ",
@@ -99,10 +96,7 @@ fn banners(app: &App, now_ms: u64) -> Vec<Line<'static>> {
         ));
     }
     if app.status().drives_silent(now_ms) {
-        let age = app
-            .status()
-            .feedback_age_ms(now_ms)
-            .map_or("never heard".to_owned(), |ms| format!("silent for {ms} ms"));
+        let age = silence(app.status().feedback_age_ms(now_ms));
         lines.push(Line::styled(
             format!(
                 " DRIVES SILENT ({age}): no joint or wheel feedback on {} ",
@@ -112,6 +106,11 @@ fn banners(app: &App, now_ms: u64) -> Vec<Line<'static>> {
         ));
     }
     lines
+}
+
+/// How long a node has been silent, for its banner.
+fn silence(age_ms: Option<u64>) -> String {
+    age_ms.map_or("never heard".to_owned(), |ms| format!("silent for {ms} ms"))
 }
 
 fn draw_command(frame: &mut Frame, area: Rect, app: &App, now_ms: u64) {
@@ -215,31 +214,27 @@ fn draw_bus(frame: &mut Frame, area: Rect, app: &App, now_ms: u64) {
 
 fn fault_text(faults: FaultFlags) -> String {
     use protocol::signal::WireField;
-    if faults.is_empty() {
-        return "none".into();
-    }
-    FaultFlags::FLAGS
-        .iter()
-        .enumerate()
-        .filter(|(bit, _)| faults.bits() & (1 << bit) != 0)
-        .map(|(_, name)| *name)
-        .collect::<Vec<_>>()
-        .join(", ")
+    flag_names(FaultFlags::FLAGS, faults.bits().into(), "none")
 }
 
 fn drive_text(flags: Option<DriveFlags>) -> String {
     use protocol::signal::WireField;
-    let Some(flags) = flags else {
-        return "no status".into();
-    };
-    if flags.is_empty() {
-        return "torque-free".into();
-    }
-    DriveFlags::FLAGS
+    flags.map_or("no status".into(), |flags| {
+        flag_names(DriveFlags::FLAGS, flags.bits().into(), "torque-free")
+    })
+}
+
+/// The names of the bits set in `bits` (bit i is `labels[i]`), or `empty` when none is.
+fn flag_names(labels: &[&str], bits: u32, empty: &str) -> String {
+    let names: Vec<&str> = labels
         .iter()
         .enumerate()
-        .filter(|(bit, _)| flags.bits() & (1 << bit) != 0)
+        .filter(|(bit, _)| bits & (1 << bit) != 0)
         .map(|(_, name)| *name)
-        .collect::<Vec<_>>()
-        .join(", ")
+        .collect();
+    if names.is_empty() {
+        empty.into()
+    } else {
+        names.join(", ")
+    }
 }
