@@ -1,0 +1,178 @@
+//! The fault layer on the in-process bus: each fault does what the plan says, is counted, and
+//! the protocol's receiver rejects every corrupted, duplicated and replayed frame.
+
+use std::time::Duration;
+
+use firmware_host::bus::Bus;
+use firmware_host::fault_plan::Faults;
+use firmware_host::faulty_bus::FaultyBus;
+use firmware_host::inproc_bus::{InprocBus, InprocEndpoint};
+use protocol::{
+    AnyMessage, BodyHeight, Frame, Receiver, RejectCause, SpeedScale, Sync, TeleopCommand,
+    TeleopMode, Tick,
+};
+
+fn command(counter: u16) -> Frame {
+    AnyMessage::TeleopCommand(TeleopCommand {
+        mode: TeleopMode::TrotForward,
+        body_height: BodyHeight::saturating_from_si(0.0),
+        speed_scale: SpeedScale::saturating_from_si(1.0),
+    })
+    .encode(counter)
+    .unwrap()
+}
+
+fn sync(tick: u32) -> Frame {
+    AnyMessage::Sync(Sync {
+        tick: Tick::from_raw(tick).unwrap(),
+    })
+    .encode(tick as u16)
+    .unwrap()
+}
+
+fn rig(faults: &str) -> (FaultyBus<InprocEndpoint>, InprocEndpoint) {
+    let bus = InprocBus::new();
+    let faulty = FaultyBus::new(bus.endpoint(), &faults.parse::<Faults>().unwrap());
+    (faulty, bus.endpoint())
+}
+
+fn drain(bus: &mut dyn Bus) -> Vec<Frame> {
+    std::iter::from_fn(|| bus.recv(Duration::ZERO).unwrap()).collect()
+}
+
+/// Sends `cycles` cycles of one command and a SYNC each; returns what the other side received.
+fn run(
+    faulty: &mut FaultyBus<InprocEndpoint>,
+    other: &mut InprocEndpoint,
+    cycles: u32,
+) -> Vec<Frame> {
+    let mut got = Vec::new();
+    for cycle in 0..cycles {
+        faulty.send(&command(cycle as u16 + 1)).unwrap();
+        faulty.send(&sync(cycle)).unwrap();
+        got.extend(drain(other));
+    }
+    got
+}
+
+#[test]
+fn a_clean_plan_changes_nothing() {
+    let (mut faulty, mut other) = rig("");
+    let got = run(&mut faulty, &mut other, 50);
+    assert_eq!(got.len(), 100);
+    assert_eq!(faulty.tx_stats().frames, 50);
+}
+
+#[test]
+fn drops_about_the_planned_share_and_never_the_sync() {
+    let (mut faulty, mut other) = rig("tx.drop=0.2,seed=3");
+    let got = run(&mut faulty, &mut other, 2000);
+    let syncs = got.iter().filter(|f| f.id() == sync(0).id()).count();
+    let commands = got.len() - syncs;
+    assert_eq!(syncs, 2000);
+    let dropped = faulty.tx_stats().dropped;
+    assert_eq!(commands as u64 + dropped, 2000);
+    assert!((320..480).contains(&dropped), "dropped {dropped} of 2000");
+}
+
+#[test]
+fn delay_holds_frames_for_whole_cycles_in_order() {
+    let (mut faulty, mut other) = rig("tx.delay=3");
+    let mut arrival = Vec::new();
+    for cycle in 0..10_u32 {
+        // What the other side has at the start of the cycle, before this cycle's frames.
+        for frame in drain(&mut other) {
+            if frame.id() == command(1).id() {
+                arrival.push((cycle, frame));
+            }
+        }
+        faulty.send(&command(cycle as u16 + 1)).unwrap();
+        faulty.send(&sync(cycle)).unwrap();
+    }
+    let expected: Vec<_> = (3..10).map(|c| (c, command(c as u16 - 2))).collect();
+    assert_eq!(arrival, expected);
+}
+
+#[test]
+fn flips_duplicates_and_replays_are_each_rejected_by_the_receiver() {
+    let (mut faulty, mut other) = rig("tx.flip=0.1,tx.duplicate=0.1,tx.replay=0.1,seed=11");
+    let got = run(&mut faulty, &mut other, 3000);
+    let mut receiver = Receiver::default();
+    let mut accepted_counters = Vec::new();
+    for frame in got.iter().filter(|f| f.id() == command(1).id()) {
+        if receiver.receive(frame.id(), frame.data()).is_ok() {
+            let decoded = protocol::decode_frame(frame.id(), frame.data()).unwrap();
+            accepted_counters.push(decoded.counter);
+        }
+    }
+    let stats = faulty.tx_stats();
+    let counters = receiver.counters();
+    assert!(
+        stats.flipped > 200 && stats.duplicated > 200 && stats.replayed > 200,
+        "{stats:?}"
+    );
+    assert_eq!(
+        u64::from(counters.get(RejectCause::Crc).raw()),
+        stats.flipped
+    );
+    let sequence = u64::from(counters.get(RejectCause::Repeated).raw())
+        + u64::from(counters.get(RejectCause::WrongSequence).raw());
+    assert_eq!(sequence, stats.duplicated + stats.replayed);
+    // Nothing old was ever accepted: the accepted counters only go up.
+    assert!(accepted_counters.windows(2).all(|w| w[1] > w[0]));
+}
+
+#[test]
+fn silencing_a_node_drops_all_of_its_frames() {
+    let (mut faulty, mut other) = rig("tx.silence=Teleop");
+    let got = run(&mut faulty, &mut other, 20);
+    assert!(got.iter().all(|f| f.id() == sync(0).id()));
+    assert_eq!(faulty.tx_stats().silenced, 20);
+}
+
+#[test]
+fn a_flood_keeps_one_valid_sequence() {
+    let (mut faulty, mut other) = rig("tx.flood=40");
+    let mut receiver = Receiver::default();
+    for _ in 0..25 {
+        // The teleop's own counter stands still; the layer owns the sequence.
+        faulty.send(&command(1)).unwrap();
+        faulty.end_cycle().unwrap();
+    }
+    let got = drain(&mut other);
+    assert_eq!(got.len(), 25 * 41);
+    for frame in &got {
+        receiver.receive(frame.id(), frame.data()).unwrap();
+    }
+    assert_eq!(faulty.tx_stats().flooded, 25 * 40);
+}
+
+#[test]
+fn reorder_swaps_a_frame_behind_the_next() {
+    let (mut faulty, mut other) = rig("tx.reorder=1");
+    faulty.send(&command(1)).unwrap();
+    faulty.send(&command(2)).unwrap();
+    faulty.send(&sync(0)).unwrap();
+    let got = drain(&mut other);
+    assert_eq!(got, [command(2), command(1), sync(0)]);
+}
+
+#[test]
+fn received_frames_can_be_faulted_too() {
+    let bus = InprocBus::new();
+    let mut faulty = FaultyBus::new(bus.endpoint(), &"rx.delay=2".parse().unwrap());
+    let mut other = bus.endpoint();
+    let mut seen = Vec::new();
+    for cycle in 0..6_u32 {
+        other.send(&command(cycle as u16 + 1)).unwrap();
+        other.send(&sync(cycle)).unwrap();
+        for frame in drain(&mut faulty) {
+            if frame.id() == command(1).id() {
+                seen.push((cycle, frame));
+            }
+        }
+    }
+    // Sent before SYNC c, received after SYNC c + 1: two cycle boundaries later.
+    let expected: Vec<_> = (1..6).map(|c| (c, command(c as u16))).collect();
+    assert_eq!(seen, expected);
+}
