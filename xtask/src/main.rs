@@ -6,6 +6,7 @@ mod busload;
 mod dbc;
 mod demo;
 mod elf;
+mod faults;
 mod firmware;
 mod fuzz;
 mod hil;
@@ -27,7 +28,8 @@ Tasks:
   test               everything CI checks: fmt, clippy -D warnings (all features), DBC
                      freshness, no f64 in the no_std crates, all tests (the headless renderer's
                      too), a thumbv7em-none-eabihf build of the no_std crates, the MCU
-                     images (`firmware`, `pil`), and the vcan suite (`hil`)
+                     images (`firmware`, `pil`), a minute of fuzzing per target (`fuzz`), and
+                     the vcan suite (`hil`)
   dbc [--check]      regenerate protocol/hybrid_robot.dbc (--check: fail if the committed file is stale)
   busload            print the per-cycle frame schedule and the bus load at 250 Hz and 1 kHz
   bench [args]       criterion benchmarks (control step, raw MuJoCo step, closed-loop cycle), then a
@@ -45,6 +47,10 @@ Tasks:
   fuzz [--seconds N] libFuzzer (cargo fuzz, nightly; installed if missing) on the frame decoders,
                      the receive path and the firmware's frame handler, N s each (default 60)
                      from the committed seeds; fails on a crash (--seeds: rewrite the seeds)
+  faults [--check]   the fault matrix (lost, late, corrupted, replayed frames, a teleop flood,
+                     silent feedback, a killed firmware, a restarted simulator, E-stops) on the
+                     closed loop in-process; writes its table into README.md (--check: fail if
+                     the README's table is stale)
   demo [options]     the report's demonstration, closed loop (STOP, W, S, A, L, K, X): sets up,
                      builds, runs scenarios/report_demo.toml with the firmware on the in-process
                      CAN bus; writes out/ (summary.json, telemetry.csv, bus.log, plots, frames)
@@ -74,6 +80,7 @@ fn main() -> ExitCode {
         "firmware" => firmware::run(),
         "pil" => pil::run(rest),
         "fuzz" => fuzz::run(rest),
+        "faults" => faults::run(rest),
         "help" | "-h" | "--help" => {
             print!("{HELP}");
             Ok(())

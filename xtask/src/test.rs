@@ -72,6 +72,8 @@ pub fn run() -> Result<(), String> {
     sh(&mut clippy)?;
     crate::firmware::run()?;
     crate::pil::run(&[])?;
+    // A minute of libFuzzer per target from the committed seeds (the long run is documented).
+    crate::fuzz::run(&["--seconds".to_string(), "60".to_string()])?;
     crate::hil::run(&[])?;
     eprintln!("test: all checks passed");
     Ok(())
