@@ -74,6 +74,13 @@ pub trait Bus {
         0
     }
 
+    /// Marks the end of a control cycle for a node that sees no SYNC (a real-time simulator, a
+    /// firmware on its own timer). Buses without a notion of cycles ignore it; the fault layer
+    /// releases delayed frames by it ([`crate::faulty_bus`]).
+    fn end_cycle(&mut self) -> Result<(), BusError> {
+        Ok(())
+    }
+
     /// A name for logs (`vcan0`, `inproc`).
     fn name(&self) -> &str;
 }

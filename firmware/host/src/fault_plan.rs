@@ -196,8 +196,12 @@ impl fmt::Display for Faults {
             if plan.flood_per_cycle > 0 {
                 items.push(format!("{direction}.flood={}", plan.flood_per_cycle));
             }
-            for node in &plan.silence {
-                items.push(format!("{direction}.silence={}", node.name()));
+            if plan.silence == FEEDBACK_NODES {
+                items.push(format!("{direction}.silence=feedback"));
+            } else {
+                for node in &plan.silence {
+                    items.push(format!("{direction}.silence={}", node.name()));
+                }
             }
         }
         if items.is_empty() {

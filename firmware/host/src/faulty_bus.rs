@@ -3,14 +3,14 @@
 //! bad bus from the command line.
 //!
 //! Time is counted in control cycles: a cycle ends when a SYNC passes through the bus in either
-//! direction (the simulator's clock), or when the owner calls [`FaultyBus::end_cycle`] (a node
+//! direction (the simulator's clock), or when the owner calls [`Bus::end_cycle`] (a node
 //! that sees no SYNC, such as a flooding teleop). Delays are in those cycles, and every random
 //! choice comes from the plan's seed, so a lockstep run with faults is repeatable.
 //!
 //! Every fault is counted in [`FaultStats`], so a test can check that each corrupted,
 //! duplicated or replayed frame was rejected by its receiver.
 
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
 use protocol::{decode_frame, AnyMessage, E2eCounter, Frame, MessageId};
@@ -63,6 +63,8 @@ struct Injector {
     flood_template: Option<AnyMessage>,
     flood_counter: Option<E2eCounter>,
     stats: FaultStats,
+    /// Per id: frames sent that any receiver must reject (flipped, duplicated, replayed).
+    bad_by_id: BTreeMap<u16, u64>,
 }
 
 impl Injector {
@@ -77,6 +79,7 @@ impl Injector {
             flood_template: None,
             flood_counter: None,
             stats: FaultStats::default(),
+            bad_by_id: BTreeMap::new(),
         }
     }
 
@@ -121,7 +124,12 @@ impl Injector {
                 self.queue.push_back((release, held));
             }
         }
+        let id = original.id();
+        if out != original {
+            self.count_bad(id);
+        }
         if self.chance(self.plan.duplicate) {
+            self.count_bad(id);
             // A copy of a corrupted frame is one more corrupted frame on the wire.
             if flipped && out != original {
                 self.stats.flipped += 1;
@@ -130,16 +138,20 @@ impl Injector {
             }
             self.queue.push_back((release, out));
         }
-        let id = original.id();
         let may_replay = !self.replayed_last.contains(&id);
         self.replayed_last.retain(|i| *i != id);
         if may_replay && self.chance(self.plan.replay) {
             if let Some(old) = self.older_frame(id) {
                 self.stats.replayed += 1;
+                self.count_bad(id);
                 self.replayed_last.push(id);
                 self.queue.push_back((release, old));
             }
         }
+    }
+
+    fn count_bad(&mut self, id: u16) {
+        *self.bad_by_id.entry(id).or_default() += 1;
     }
 
     /// The first frame due at `cycle`, in queue order: a frame that is not delayed (SYNC, a
@@ -262,6 +274,13 @@ impl<B: Bus> FaultyBus<B> {
         }
     }
 
+    /// Changes the plan from now on; frames already held back keep their release cycle, and the
+    /// counts go on.
+    pub fn set_faults(&mut self, faults: &Faults) {
+        self.tx.plan = faults.tx.clone();
+        self.rx.plan = faults.rx.clone();
+    }
+
     /// What the faults did to sent frames.
     pub fn tx_stats(&self) -> FaultStats {
         self.tx.stats
@@ -272,6 +291,18 @@ impl<B: Bus> FaultyBus<B> {
         self.rx.stats
     }
 
+    /// Frames on `raw_id` this node sent that every receiver of the id must reject: flipped,
+    /// duplicated and replayed ones.
+    pub fn tx_bad_frames(&self, raw_id: u16) -> u64 {
+        self.tx.bad_by_id.get(&raw_id).copied().unwrap_or(0)
+    }
+
+    /// Frames on `raw_id` this node received flipped, duplicated or replayed (which it must
+    /// reject).
+    pub fn rx_bad_frames(&self, raw_id: u16) -> u64 {
+        self.rx.bad_by_id.get(&raw_id).copied().unwrap_or(0)
+    }
+
     /// Control cycles ended so far.
     pub fn cycle(&self) -> u64 {
         self.cycle
@@ -280,14 +311,6 @@ impl<B: Bus> FaultyBus<B> {
     /// The bus underneath.
     pub fn inner_mut(&mut self) -> &mut B {
         &mut self.inner
-    }
-
-    /// Ends a control cycle for a node that sees no SYNC: the flood's frames for this cycle go
-    /// out, then held-back and delayed frames that are due.
-    pub fn end_cycle(&mut self) -> Result<(), BusError> {
-        self.tx.flood(self.cycle);
-        self.close_cycle();
-        self.flush_tx()
     }
 
     fn close_cycle(&mut self) {
@@ -336,6 +359,14 @@ impl<B: Bus> Bus for FaultyBus<B> {
                 None => return Ok(None),
             }
         }
+    }
+
+    /// Ends a control cycle for a node that sees no SYNC: the flood's frames for this cycle go
+    /// out, then held-back and delayed frames that are due.
+    fn end_cycle(&mut self) -> Result<(), BusError> {
+        self.tx.flood(self.cycle);
+        self.close_cycle();
+        self.flush_tx()
     }
 
     fn foreign_frames(&self) -> u64 {

@@ -7,6 +7,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use clap::{Parser, ValueEnum};
+use firmware_host::fault_plan::Faults;
+use firmware_host::faulty_bus::FaultyBus;
 use firmware_host::runner::{self, Clock, RunnerConfig};
 use firmware_host::socketcan_bus::SocketCanBus;
 
@@ -36,6 +38,12 @@ struct Cli {
     /// Lockstep: exit with an error when no SYNC arrives for this many seconds.
     #[arg(long)]
     idle_timeout_s: Option<f64>,
+    /// Break the firmware's own bus connection on purpose: `rx.*` faults hit the feedback it
+    /// receives, `tx.*` the commands it sends, e.g. `rx.drop=0.05,tx.flip=0.01,seed=3`
+    /// (faults: drop, delay, duplicate, reorder, flip, replay, silence=NODE; delays count
+    /// SYNC-delimited cycles). SYNC is never faulted.
+    #[arg(long, value_name = "PLAN", default_value = "")]
+    faults: Faults,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -55,7 +63,7 @@ fn main() -> ExitCode {
         tracing::warn!("Ctrl-C/SIGTERM will not stop the drives first: {e}");
     }
     let mut bus = match SocketCanBus::open(&cli.bus) {
-        Ok(bus) => bus,
+        Ok(bus) => FaultyBus::new(bus, &cli.faults),
         Err(e) => {
             eprintln!("firmware-host: {e}");
             return ExitCode::FAILURE;
@@ -80,6 +88,14 @@ fn main() -> ExitCode {
                 "ticks {} | frames in {} out {} | rejected {:?} | overruns {}",
                 stats.ticks, stats.frames_in, stats.frames_out, stats.rejected, stats.overruns
             );
+            if !cli.faults.tx.is_clean() || !cli.faults.rx.is_clean() {
+                println!(
+                    "faults {} | on received {:?} | on sent {:?}",
+                    cli.faults,
+                    bus.rx_stats(),
+                    bus.tx_stats()
+                );
+            }
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -165,6 +165,7 @@ fn timer(
         }
         stats.ticks += 1;
         tick = tick.plus(1);
+        bus.end_cycle()?;
         let deadline = start + period * u32::try_from(stats.ticks).unwrap_or(u32::MAX);
         let now = Instant::now();
         if now > deadline + period {
