@@ -52,6 +52,18 @@ pub struct Config {
     /// is stopped within 500 ms of teleop dying: its last heartbeat may have gone out up to one
     /// 20 ms period before, and the watchdog acts on the next 4 ms tick.
     pub teleop_timeout_ms: u32,
+    /// Length of one window of the link monitor, ms: the inbound loss ratio is judged once per
+    /// window (see [`crate::link`]). 1 s holds well over a thousand frames at 250 Hz, so 10 %
+    /// loss stands far above the count's noise at 5 %, and a lossy link is stopped within two
+    /// windows of the loss starting.
+    pub link_window_ms: u32,
+    /// A window that loses more than this share of the frames sent to the controller degrades
+    /// the link: the robot stops and refuses new motion, ‰ (100 = 10 %). At 20 % loss one
+    /// operator command in five is gone, and E-stop clears or stop keys may need repeating.
+    pub link_degrade_permille: u32,
+    /// A window that loses at most this share recovers the link, ‰ (30 = 3 %). Below the
+    /// degrade threshold so that a loss ratio near either one does not make the state flicker.
+    pub link_recover_permille: u32,
     /// Pitch or roll beyond this is a fall: fault, rad.
     pub tilt_limit_rad: f32,
 }
@@ -88,6 +100,9 @@ impl Config {
         feedback_timeout_ms: 50,
         imu_timeout_ms: 50,
         teleop_timeout_ms: 460,
+        link_window_ms: 1_000,
+        link_degrade_permille: 100,
+        link_recover_permille: 30,
         tilt_limit_rad: crate::math::deg_to_rad(45.0),
     };
 

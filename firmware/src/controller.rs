@@ -61,6 +61,9 @@ pub struct Status {
 pub enum ConfigError {
     /// The trot frequency is zero or not below the control rate.
     TrotFrequency,
+    /// The link monitor's window is shorter than one tick, or its thresholds are not
+    /// `recover ≤ degrade ≤ 1000 ‰` (checked by [`crate::node::Node::new`], which runs it).
+    LinkMonitor,
 }
 
 /// The robot's controller.
@@ -85,6 +88,8 @@ pub struct Controller {
     drive_faults: [bool; 5],
     tilted: bool,
     non_finite: bool,
+    /// Whether the node's link monitor finds the bus too lossy (see [`Controller::set_link_degraded`]).
+    link_degraded: bool,
     ik_failures: u32,
 }
 
@@ -111,6 +116,7 @@ impl Controller {
             drive_faults: [false; 5],
             tilted: false,
             non_finite: false,
+            link_degraded: false,
             ik_failures: 0,
         })
     }
@@ -140,6 +146,27 @@ impl Controller {
         &self.trot
     }
 
+    /// Whether the link is degraded (as last set by [`Controller::set_link_degraded`]).
+    pub fn link_degraded(&self) -> bool {
+        self.link_degraded
+    }
+
+    /// Tells the controller whether the bus is too lossy to move on (the node's
+    /// [`LinkMonitor`](crate::link::LinkMonitor) decides; call before [`Controller::step`]).
+    ///
+    /// When the link becomes degraded the controller stops once, as for a lost operator
+    /// ([`Event::LinkDegraded`]: a trot stands still on four legs, a wheel drive brakes to a
+    /// standstill while balancing), and reports [`FaultFlags::LINK_DEGRADED`]. While it stays
+    /// degraded, operator requests other than Stop are refused — they are still taken as the
+    /// operator's last key, so a teleop that keeps resending its mode neither restarts the
+    /// motion now nor when the link recovers; after recovery the next new key acts.
+    pub fn set_link_degraded(&mut self, degraded: bool) {
+        if degraded && !self.link_degraded {
+            self.apply(Event::LinkDegraded);
+        }
+        self.link_degraded = degraded;
+    }
+
     /// Takes one accepted message received at `now`. Messages the controller does not consume
     /// (its own commands echoed, other nodes' status) are ignored.
     pub fn on_message(&mut self, now: Tick, message: &AnyMessage) {
@@ -158,6 +185,8 @@ impl Controller {
                         if self.fault_causes(now).is_empty() {
                             self.apply(Event::Reset);
                         }
+                    } else if self.link_degraded && mode != protocol::TeleopMode::Stop {
+                        // A lossy link starts no motion (see `set_link_degraded`).
                     } else {
                         self.apply(Event::Request(mode));
                     }
@@ -255,6 +284,9 @@ impl Controller {
         }
         if self.non_finite {
             faults = faults.with(FaultFlags::NON_FINITE);
+        }
+        if self.link_degraded {
+            faults = faults.with(FaultFlags::LINK_DEGRADED);
         }
         let attitude = self.sensors.attitude;
         Status {

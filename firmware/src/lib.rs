@@ -8,7 +8,7 @@
 //!
 //! | layer | module | what it does |
 //! |---|---|---|
-//! | CAN node | [`node`], [`can`] | frames in (decode, E2E, counted rejects), frames out on the bus schedule |
+//! | CAN node | [`node`], [`can`], [`rate_limit`], [`link`] | frames in (decode, E2E, counted rejects, a per-tick budget for operator commands, the link's loss ratio), frames out on the bus schedule |
 //! | control step | [`controller`] | supervisor → FSM → leg goals + smoothing → wheel law → clamps |
 //! | modes | [`fsm`] | states, events and the transition table |
 //! | legs | [`kinematics`], [`posture`], [`gait`], [`foot_trajectory`], [`sine_gait`], [`phase`], [`smoothing`] | IK/FK, stance and fold, the trot |
@@ -37,10 +37,12 @@ pub mod fsm;
 pub mod gait;
 pub mod kinematics;
 pub mod limits;
+pub mod link;
 pub mod math;
 pub mod node;
 pub mod phase;
 pub mod posture;
+pub mod rate_limit;
 pub mod safety;
 pub mod sensors;
 pub mod sine_gait;

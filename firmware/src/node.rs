@@ -2,10 +2,18 @@
 //!
 //! [`Node::on_frame`] runs every received frame through the protocol's
 //! [`Receiver`] — decode, CRC, rolling counter — so that nothing rejected
-//! reaches the controller, and every rejection is counted by cause. [`Node::poll`] runs one
-//! control tick and encodes the frames due in it, following the protocol's bus schedule
-//! ([`protocol::busload::SCHEDULE`]): wheel torques every tick, leg targets at up to 250 Hz,
-//! status at 50 Hz, the reject counters at 10 Hz.
+//! reaches the controller, and every rejection is counted by cause. Two guards sit between the
+//! receiver and the controller:
+//!
+//! - a per-tick budget of [`TELEOP_COMMANDS_PER_TICK`] operator commands, so that a babbling
+//!   teleop node cannot take the controller's period; the excess is refused and counted as
+//!   [`RejectCause::RateLimited`](protocol::RejectCause::RateLimited);
+//! - the [`LinkMonitor`], which measures the inbound loss from the E2E sequence gaps and, when
+//!   the bus loses too much, has the controller stop ([`Controller::set_link_degraded`]).
+//!
+//! [`Node::poll`] runs one control tick and encodes the frames due in it, following the
+//! protocol's bus schedule ([`protocol::busload::SCHEDULE`]): wheel torques every tick, leg
+//! targets at up to 250 Hz, status at 50 Hz, the reject counters at 10 Hz.
 
 use heapless::Vec;
 use protocol::busload::SCHEDULE;
@@ -16,7 +24,17 @@ use protocol::{
 
 use crate::config::Config;
 use crate::controller::{ConfigError, Controller, Output};
+use crate::link::LinkMonitor;
+use crate::rate_limit::TickBudget;
 use crate::time::Tick;
+
+/// Most operator commands ([`MessageId::TeleopCommand`]) handed to the controller per control
+/// tick; more are refused as [`DecodeError::RateLimited`]. The teleop sends one every 20 ms and
+/// one at once when a key changes it, so a genuine operator needs at most 2 in a tick at any
+/// supported rate, while a node babbling 10 000 frames/s (40 per 4 ms tick) costs the
+/// controller 2. E-stops are never limited (they must always act), nor are heartbeats (they only
+/// feed a watchdog, and their flood costs nothing more than the receive check).
+pub const TELEOP_COMMANDS_PER_TICK: u8 = 2;
 
 /// Most frames the node sends in one tick.
 pub const MAX_FRAMES_PER_TICK: usize = 4;
@@ -37,6 +55,8 @@ struct TxCounters {
 #[derive(Debug, Clone)]
 pub struct Node {
     receiver: Receiver,
+    teleop_budget: TickBudget,
+    link: LinkMonitor,
     controller: Controller,
     tx: TxCounters,
     encode_failures: u32,
@@ -45,8 +65,16 @@ pub struct Node {
 impl Node {
     /// A node running `config`.
     pub fn new(config: Config) -> Result<Self, ConfigError> {
+        let link = LinkMonitor::new(
+            config.rate.ticks_from_ms(config.link_window_ms),
+            config.link_degrade_permille,
+            config.link_recover_permille,
+        )
+        .ok_or(ConfigError::LinkMonitor)?;
         Ok(Self {
             receiver: Receiver::default(),
+            teleop_budget: TickBudget::new(TELEOP_COMMANDS_PER_TICK),
+            link,
             controller: Controller::new(config)?,
             tx: TxCounters::default(),
             encode_failures: 0,
@@ -56,6 +84,11 @@ impl Node {
     /// The controller inside.
     pub fn controller(&self) -> &Controller {
         &self.controller
+    }
+
+    /// The link monitor (its state and last measured loss).
+    pub fn link(&self) -> &LinkMonitor {
+        &self.link
     }
 
     /// Frames rejected so far, by cause, and frames lost in sequence.
@@ -70,14 +103,30 @@ impl Node {
 
     /// Takes one received frame. A rejected frame is counted and returned as the error; it
     /// never reaches the controller.
+    ///
+    /// An operator command beyond this tick's budget ([`TELEOP_COMMANDS_PER_TICK`]) has passed
+    /// the receiver's checks — its counter keeps the sequence in step — but is refused as
+    /// [`DecodeError::RateLimited`] and counted like any other rejection. Only frames handed to
+    /// the controller count for the link monitor, so a flood cannot dilute the loss it measures.
     pub fn on_frame(&mut self, now: Tick, raw_id: u16, data: &[u8]) -> Result<(), DecodeError> {
         let accepted = self.receiver.receive(raw_id, data)?;
+        if matches!(accepted.message, AnyMessage::TeleopCommand(_)) && !self.teleop_budget.take() {
+            let error = DecodeError::RateLimited { id: raw_id };
+            self.receiver.refuse(error);
+            return Err(error);
+        }
+        self.link.record(accepted.status);
         self.controller.on_message(now, &accepted.message);
         Ok(())
     }
 
-    /// Runs one control tick and returns its output and the frames due.
+    /// Runs one control tick and returns its output and the frames due. The frames received
+    /// until the next call get a fresh operator-command budget, and the link monitor's verdict
+    /// reaches the controller before its step.
     pub fn poll(&mut self, now: Tick) -> (Output, TickFrames) {
+        self.teleop_budget.refill();
+        let degraded = self.link.update(now);
+        self.controller.set_link_degraded(degraded);
         let output = self.controller.step(now);
         let hz = self.controller.config().rate.hz();
         let due = |id: MessageId| {

@@ -45,6 +45,7 @@ fn all_events() -> Vec<Event> {
     .collect();
     events.extend([
         Event::TeleopLost,
+        Event::LinkDegraded,
         Event::PoseReached,
         Event::EStopLatch,
         Event::EStopClear,
@@ -69,6 +70,7 @@ fn the_documented_table_row_by_row() {
         // Legs
         (Legs(TROT_F), req(TeleopMode::Stop), Legs(LegMotion::Stand)),
         (Legs(TROT_F), Event::TeleopLost, Legs(LegMotion::Stand)),
+        (Legs(TROT_F), Event::LinkDegraded, Legs(LegMotion::Stand)),
         (
             Legs(LegMotion::Stand),
             req(TeleopMode::TrotBackward),
@@ -126,6 +128,13 @@ fn the_documented_table_row_by_row() {
         ),
         (
             Wheels(DRIVE_F),
+            Event::LinkDegraded,
+            Wheels(WheelMotion::Balance),
+        ),
+        (Hold, Event::LinkDegraded, Hold),
+        (Fault, Event::LinkDegraded, Fault),
+        (
+            Wheels(DRIVE_F),
             req(TeleopMode::WheelRotate),
             Wheels(WheelMotion::Rotate),
         ),
@@ -174,7 +183,10 @@ fn every_request_in_every_state_has_a_defined_safe_result() {
                 assert_eq!(next, State::Fault, "{event:?} must not leave Fault");
             }
             // A stop request never starts a motion.
-            if matches!(event, Event::Request(TeleopMode::Stop) | Event::TeleopLost) {
+            if matches!(
+                event,
+                Event::Request(TeleopMode::Stop) | Event::TeleopLost | Event::LinkDegraded
+            ) {
                 assert!(
                     matches!(
                         next.mode(),

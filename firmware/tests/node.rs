@@ -1,10 +1,13 @@
 //! The controller as a CAN node: what goes out each tick, and what happens to bad frames.
 
-use firmware::fsm::State;
+use firmware::fsm::{Direction, LegMotion, State, WheelMotion};
+use firmware::node::TELEOP_COMMANDS_PER_TICK;
 use firmware::{Config, Node, Tick};
 use protocol::{
-    decode_frame, AnyMessage, BodyHeight, DecodeError, DriveEnable, MessageId, RejectCause,
-    SpeedScale, TeleopCommand, TeleopMode,
+    decode_frame, Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, DecodeError,
+    DriveEnable, EStop, EStopAction, Imu, JointVelocity, Leg, LegFeedback, MessageId, NodeId,
+    QuatComponent, RejectCause, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, Torque,
+    WheelAngle, WheelFeedback, WheelVelocity,
 };
 
 fn teleop_frame(mode: TeleopMode, counter: u16) -> protocol::Frame {
@@ -104,4 +107,147 @@ fn the_readmes_cansend_estop_latches_and_clears() {
     assert_eq!(node.controller().state(), State::EStop);
     assert!(node.on_frame(Tick(3), 0x000, &clear).is_err());
     assert_eq!(node.controller().state(), State::EStop);
+}
+
+/// The feedback of one tick (four legs, wheels, IMU) with rolling counter `counter`.
+fn feedback_frames(counter: u16) -> Vec<protocol::Frame> {
+    let mut messages: Vec<AnyMessage> = Leg::ALL
+        .iter()
+        .map(|leg| {
+            AnyMessage::LegFeedback(
+                *leg,
+                LegFeedback {
+                    position: [Angle::saturating_from_si(0.0); 4],
+                    velocity: [JointVelocity::saturating_from_si(0.0); 4],
+                    effort: [Torque::saturating_from_si(0.0); 4],
+                },
+            )
+        })
+        .collect();
+    messages.push(AnyMessage::WheelFeedback(WheelFeedback {
+        position: [WheelAngle::saturating_from_si(0.0); 2],
+        velocity: [WheelVelocity::saturating_from_si(0.0); 2],
+        effort: [Torque::saturating_from_si(0.0); 2],
+    }));
+    messages.push(AnyMessage::Imu(Imu {
+        orientation: [1.0, 0.0, 0.0, 0.0].map(QuatComponent::saturating_from_si),
+        angular_rate: [AngularRate::saturating_from_si(0.0); 3],
+        acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
+    }));
+    messages
+        .iter()
+        .map(|m| m.encode(counter).unwrap())
+        .collect()
+}
+
+/// Sends one teleop command per mode, counters from `*counter` on; returns how many the node
+/// applied and how many it refused as rate limited (any other refusal fails the test).
+fn flood(node: &mut Node, now: u32, modes: &[TeleopMode], counter: &mut u16) -> (u32, u32) {
+    let (mut applied, mut limited) = (0, 0);
+    for mode in modes {
+        let frame = teleop_frame(*mode, *counter);
+        *counter += 1;
+        match node.on_frame(Tick(now), frame.id(), frame.data()) {
+            Ok(()) => applied += 1,
+            Err(DecodeError::RateLimited { id: 0x200 }) => limited += 1,
+            Err(other) => panic!("teleop frame {counter} refused: {other:?}"),
+        }
+    }
+    (applied, limited)
+}
+
+#[test]
+fn a_teleop_flood_is_rate_limited_per_tick_and_counted_and_other_traffic_still_flows() {
+    assert_eq!(TELEOP_COMMANDS_PER_TICK, 2);
+    let mut node = Node::new(Config::ROBOT).unwrap();
+    let mut counter = 0;
+    // 10 000 frames/s from a babbling teleop: 40 valid frames, in sequence, in one 4 ms tick.
+    // The first two act (Stand, then trot); any of the 38 Folds after them would fold the legs.
+    let mut modes = vec![TeleopMode::Stand, TeleopMode::TrotForward];
+    modes.extend([TeleopMode::Fold; 38]);
+    assert_eq!(flood(&mut node, 0, &modes, &mut counter), (2, 38));
+    assert_eq!(
+        node.controller().state(),
+        State::Standing(LegMotion::Trot(Direction::Forward))
+    );
+    assert_eq!(
+        node.reject_counters().get(RejectCause::RateLimited).raw(),
+        38
+    );
+    assert_eq!(node.reject_counters().total(), 38);
+    // The rest of the bus is served in the same tick: feedback, heartbeats (not limited).
+    for frame in feedback_frames(0) {
+        node.on_frame(Tick(0), frame.id(), frame.data())
+            .unwrap_or_else(|e| panic!("feedback {:03X} refused: {e:?}", frame.id()));
+    }
+    for n in 0..40 {
+        let heartbeat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
+            uptime: protocol::Millis::from_raw(n).unwrap(),
+        })
+        .encode(n as u16)
+        .unwrap();
+        node.on_frame(Tick(0), heartbeat.id(), heartbeat.data())
+            .unwrap();
+    }
+    let (output, _) = node.poll(Tick(0));
+    assert!(output.legs_enabled, "the feedback armed the drives");
+    // The next tick has a new budget, and the limited frames kept the sequence in step: the
+    // next two act (stop, then fold), the rest is limited again, none is out of sequence.
+    let mut modes = vec![TeleopMode::Stop, TeleopMode::Fold];
+    modes.extend([TeleopMode::Stand; 38]);
+    assert_eq!(flood(&mut node, 1, &modes, &mut counter), (2, 38));
+    assert_eq!(
+        node.controller().state(),
+        State::Folding(WheelMotion::Balance)
+    );
+    for frame in feedback_frames(1) {
+        node.on_frame(Tick(1), frame.id(), frame.data()).unwrap();
+    }
+    let counters = node.reject_counters();
+    assert_eq!(counters.get(RejectCause::RateLimited).raw(), 76);
+    assert_eq!(counters.total(), 76);
+    assert_eq!(counters.lost.raw(), 0);
+    // The limit holds per tick, whatever the gap between ticks: one command per poll is served.
+    for tick in 2..50 {
+        node.poll(Tick(tick));
+        assert_eq!(
+            flood(&mut node, tick, &[TeleopMode::Fold], &mut counter),
+            (1, 0)
+        );
+    }
+}
+
+#[test]
+fn an_estop_in_a_teleop_flood_acts() {
+    let mut node = Node::new(Config::ROBOT).unwrap();
+    let mut counter = 0;
+    assert_eq!(
+        flood(&mut node, 0, &[TeleopMode::Fold; 20], &mut counter),
+        (2, 18)
+    );
+    assert_eq!(
+        node.controller().state(),
+        State::Folding(WheelMotion::Balance)
+    );
+    // The budget is spent, and an E-stop still acts at once.
+    let latch = AnyMessage::EStop(EStop {
+        action: EStopAction::Latch,
+        source: NodeId::Teleop,
+    })
+    .encode(0)
+    .unwrap();
+    node.on_frame(Tick(0), latch.id(), latch.data())
+        .expect("an E-stop is never rate limited");
+    assert_eq!(node.controller().state(), State::EStop);
+    assert_eq!(
+        flood(&mut node, 0, &[TeleopMode::Fold; 20], &mut counter),
+        (0, 20)
+    );
+    node.poll(Tick(0));
+    assert_eq!(
+        flood(&mut node, 1, &[TeleopMode::Stand; 40], &mut counter),
+        (2, 38)
+    );
+    assert_eq!(node.controller().state(), State::EStop);
+    assert_eq!(node.reject_counters().total(), 18 + 20 + 38);
 }

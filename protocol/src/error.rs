@@ -40,6 +40,14 @@ pub enum DecodeError {
         /// Identifier of the frame.
         id: u16,
     },
+    /// The frame passed every check, but its sender exceeded the rate the receiver serves for
+    /// this identifier (a babbling node); the receiver drops it so that it keeps its period and
+    /// serves the rest of the bus. The frame's counter still advanced the sequence, so the
+    /// sender's next frame is in step.
+    RateLimited {
+        /// Identifier of the frame.
+        id: u16,
+    },
 }
 
 /// Cause of a rejection, for counters.
@@ -58,17 +66,20 @@ pub enum RejectCause {
     Repeated = 4,
     /// See [`DecodeError::WrongSequence`].
     WrongSequence = 5,
+    /// See [`DecodeError::RateLimited`].
+    RateLimited = 6,
 }
 
 impl RejectCause {
     /// Every cause, in counter order.
-    pub const ALL: [RejectCause; 6] = [
+    pub const ALL: [RejectCause; 7] = [
         RejectCause::UnknownId,
         RejectCause::WrongLength,
         RejectCause::Crc,
         RejectCause::OutOfRange,
         RejectCause::Repeated,
         RejectCause::WrongSequence,
+        RejectCause::RateLimited,
     ];
 
     /// Short name for logs and tables.
@@ -80,6 +91,7 @@ impl RejectCause {
             RejectCause::OutOfRange => "out_of_range",
             RejectCause::Repeated => "repeated",
             RejectCause::WrongSequence => "wrong_sequence",
+            RejectCause::RateLimited => "rate_limited",
         }
     }
 }
@@ -94,6 +106,7 @@ impl DecodeError {
             DecodeError::OutOfRange { .. } => RejectCause::OutOfRange,
             DecodeError::Repeated { .. } => RejectCause::Repeated,
             DecodeError::WrongSequence { .. } => RejectCause::WrongSequence,
+            DecodeError::RateLimited { .. } => RejectCause::RateLimited,
         }
     }
 
@@ -134,6 +147,9 @@ impl core::fmt::Display for DecodeError {
                     f,
                     "CAN id 0x{id:03X}: rolling counter out of sequence (stale or replayed)"
                 )
+            }
+            DecodeError::RateLimited { id } => {
+                write!(f, "CAN id 0x{id:03X}: over the receiver's rate limit")
             }
         }
     }

@@ -1,7 +1,7 @@
 //! The receiving side of the bus: decode, sequence-check and count every rejection.
 
 use crate::e2e::{E2eChecker, E2eStatus};
-use crate::error::DecodeError;
+use crate::error::{DecodeError, RejectCause};
 use crate::id::MessageId;
 use crate::message::{decode_frame, AnyMessage};
 use crate::msg::{EStop, RejectCounters};
@@ -43,7 +43,7 @@ impl Receiver {
         Self {
             checkers: [E2eChecker::new(max_delta); MessageId::ALL.len()],
             counters: RejectCounters {
-                rejected: [crate::units::Count::ZERO; 6],
+                rejected: [crate::units::Count::ZERO; RejectCause::ALL.len()],
                 lost: crate::units::Count::ZERO,
             },
         }
@@ -61,6 +61,14 @@ impl Receiver {
             Err(error) => self.counters.record(error.cause()),
         }
         result
+    }
+
+    /// Counts the refusal of a frame this receiver accepted but its caller will not act on
+    /// (say [`DecodeError::RateLimited`]: a flood of valid frames), so that every frame not
+    /// acted on is counted by cause. The frame's sequence step stands: the sender's next frame
+    /// is still in sequence.
+    pub fn refuse(&mut self, error: DecodeError) {
+        self.counters.record(error.cause());
     }
 
     fn check(&mut self, raw_id: u16, data: &[u8]) -> Result<Accepted, DecodeError> {

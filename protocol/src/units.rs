@@ -194,6 +194,9 @@ wire_flags!(
         SYNC_LOST = 6 => "sync_lost",
         /// A computed command was not finite and was replaced by a safe one.
         NON_FINITE = 7 => "non_finite",
+        /// The bus loses too many of the controller's inbound frames: motion stops and new
+        /// motion requests are refused until the link recovers.
+        LINK_DEGRADED = 8 => "link_degraded",
     }
 );
 

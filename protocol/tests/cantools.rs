@@ -117,6 +117,7 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
                 "drive_fault",
                 "sync_lost",
                 "non_finite",
+                "link_degraded",
             ];
             for (bit, flag) in flags.iter().enumerate() {
                 put(

@@ -210,6 +210,26 @@ fn a_replayed_old_frame_is_rejected_as_out_of_sequence() {
 }
 
 #[test]
+fn a_frame_refused_after_acceptance_is_counted_as_rate_limited_and_keeps_the_sequence() {
+    let mut rx = Receiver::default();
+    let first = teleop_frame(7);
+    assert!(rx.receive(first.id(), first.data()).is_ok());
+    // The caller's rate limit drops the next frame after the receiver accepted it.
+    let flooded = teleop_frame(8);
+    assert!(rx.receive(flooded.id(), flooded.data()).is_ok());
+    rx.refuse(DecodeError::RateLimited { id: flooded.id() });
+    only_cause(&rx, RejectCause::RateLimited);
+    assert_eq!(RejectCause::RateLimited.name(), "rate_limited");
+    // The sender's next frame is in sequence: the refused one still counted as received.
+    let next = teleop_frame(9);
+    assert_eq!(
+        rx.receive(next.id(), next.data()).unwrap().status,
+        E2eStatus::Ok
+    );
+    assert_eq!(rx.counters().lost.raw(), 0);
+}
+
+#[test]
 fn lost_frames_are_accepted_and_counted_as_lost_not_rejected() {
     let mut rx = Receiver::default();
     for counter in [0, 1, 4] {

@@ -26,9 +26,9 @@ pub struct BusCounters {
     pub frames_sent: u64,
     /// Frames the simulator received.
     pub frames_received: u64,
-    /// Frames the firmware rejected, by cause: unknown id, wrong length, CRC, out of range,
-    /// repeated, wrong sequence.
-    pub firmware_rejected: [u64; 6],
+    /// Frames the firmware rejected, by cause, in [`protocol::RejectCause::ALL`] order: unknown
+    /// id, wrong length, CRC, out of range, repeated, wrong sequence, rate limited.
+    pub firmware_rejected: [u64; protocol::RejectCause::ALL.len()],
     /// Frames the firmware found missing from sequences.
     pub firmware_lost: u64,
     /// Frames the drives rejected.

@@ -211,7 +211,10 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
     let mut watch_error = None;
     let progress = progress_bar(config.progress, cycles);
     let mut interrupted = false;
-    let firmware_counters = Rc::new(Cell::new(([0_u64; 6], 0_u64)));
+    let firmware_counters = Rc::new(Cell::new((
+        [0_u64; protocol::RejectCause::ALL.len()],
+        0_u64,
+    )));
     let specs: Vec<SegmentSpec> = if config.segments.is_empty() {
         vec![SegmentSpec {
             start_s: 0.0,

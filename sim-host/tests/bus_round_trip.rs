@@ -181,7 +181,7 @@ fn leg_drives_servo_to_the_frames_targets_and_report_every_cycle() {
         "{} feedback frames",
         c.feedback_frames
     );
-    assert_eq!(c.receiver.counters().rejected.map(|n| n.raw()), [0; 6]);
+    assert_eq!(c.receiver.counters().rejected.map(|n| n.raw()), [0; 7]);
     assert_eq!(c.receiver.counters().lost.raw(), 0);
     let fl = c.leg_feedback[0].expect("front-left feedback");
     let got = [fl.position[0].si(), fl.position[2].si()];

@@ -182,25 +182,29 @@ fn draw_drives(frame: &mut Frame, area: Rect, app: &App) {
 
 fn draw_bus(frame: &mut Frame, area: Rect, app: &App, now_ms: u64) {
     let status = app.status();
-    let rejected = status.rejected().map_or("no report yet".to_owned(), |r| {
-        let causes = [
-            ("unknown id", RejectCause::UnknownId),
-            ("length", RejectCause::WrongLength),
-            ("crc", RejectCause::Crc),
-            ("range", RejectCause::OutOfRange),
-            ("repeated", RejectCause::Repeated),
-            ("sequence", RejectCause::WrongSequence),
-        ];
-        let mut text: Vec<String> = causes
-            .iter()
-            .map(|(name, cause)| format!("{name} {}", r.get(*cause).raw()))
-            .collect();
-        text.push(format!("lost {}", r.lost.raw()));
-        text.join(" · ")
-    });
+    // Lost frames go on the first line: seven causes fill the second.
+    let (rejected, lost) =
+        status
+            .rejected()
+            .map_or(("no report yet".to_owned(), "?".to_owned()), |r| {
+                let causes = [
+                    ("unknown id", RejectCause::UnknownId),
+                    ("length", RejectCause::WrongLength),
+                    ("crc", RejectCause::Crc),
+                    ("range", RejectCause::OutOfRange),
+                    ("repeated", RejectCause::Repeated),
+                    ("sequence", RejectCause::WrongSequence),
+                    ("rate limited", RejectCause::RateLimited),
+                ];
+                let text: Vec<String> = causes
+                    .iter()
+                    .map(|(name, cause)| format!("{name} {}", r.get(*cause).raw()))
+                    .collect();
+                (text.join(" · "), r.lost.raw().to_string())
+            });
     let lines = vec![
         Line::from(format!(
-            "{:.0} frames/s   undecodable {}",
+            "{:.0} frames/s   undecodable {}   controller lost {lost}",
             status.frames_per_s(now_ms),
             status.undecodable()
         )),

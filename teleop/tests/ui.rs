@@ -198,6 +198,8 @@ fn the_bus_status_is_rendered_and_silence_gets_a_banner() {
         counters.record(RejectCause::Crc);
     }
     counters.record(RejectCause::Repeated);
+    counters.record(RejectCause::RateLimited);
+    counters.record(RejectCause::RateLimited);
     app.observe(
         1_004,
         &AnyMessage::RejectCounters(counters).encode(0).unwrap(),
@@ -222,6 +224,8 @@ fn the_bus_status_is_rendered_and_silence_gets_a_banner() {
         "BR     no status",
         "crc 3",
         "repeated 1",
+        "rate limited 2",
+        "controller lost 0",
         "5 frames/s",
         "x +1.23 m",
         "yaw +30°",

@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 use firmware::config::Config;
 use firmware::node::Node;
 use firmware::time::{Tick, TickRate};
-use protocol::{decode_frame, AnyMessage, MessageId};
+use protocol::{decode_frame, AnyMessage, MessageId, RejectCause};
 
 use crate::bus::{Bus, BusError};
 
@@ -50,9 +50,9 @@ pub struct RunnerStats {
     pub frames_in: u64,
     /// Frames sent.
     pub frames_out: u64,
-    /// Frames the firmware rejected, by cause (unknown id, wrong length, CRC, out of range,
-    /// repeated, wrong sequence).
-    pub rejected: [u64; 6],
+    /// Frames the firmware rejected, by cause, in [`RejectCause::ALL`] order (unknown id, wrong
+    /// length, CRC, out of range, repeated, wrong sequence, rate limited).
+    pub rejected: [u64; RejectCause::ALL.len()],
     /// Timer mode: ticks that started later than one period after their deadline.
     pub overruns: u64,
 }

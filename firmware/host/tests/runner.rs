@@ -58,7 +58,7 @@ fn lockstep_answers_every_sync_with_a_wheel_command_then_stops_the_drives() {
     }
     let stats = runner.join().unwrap().unwrap();
     assert_eq!((commands, stats.ticks), (50, 50));
-    assert_eq!(stats.rejected, [0; 6]);
+    assert_eq!(stats.rejected, [0; 7]);
     // The last frames: legs torque-free and zero wheel torque, accepted in sequence.
     let mut last_legs = None;
     while let Some(frame) = sim.recv(Duration::from_millis(100)).unwrap() {

@@ -7,21 +7,24 @@ use crate::signal::{array, scalar, Field};
 use crate::units::Count;
 
 /// Names of the rejection counters, in [`RejectCause`] order.
-pub const REJECT_NAMES: [&str; 6] = [
+pub const REJECT_NAMES: [&str; RejectCause::ALL.len()] = [
     RejectCause::UnknownId.name(),
     RejectCause::WrongLength.name(),
     RejectCause::Crc.name(),
     RejectCause::OutOfRange.name(),
     RejectCause::Repeated.name(),
     RejectCause::WrongSequence.name(),
+    RejectCause::RateLimited.name(),
 ];
 
 /// Frames the controller rejected, by cause, id `0x600` (diagnostics), controller → anyone.
 ///
 /// | byte  | field      | type    | meaning                                            |
 /// |-------|------------|---------|----------------------------------------------------|
-/// | 4–15  | `rejected` | 6 × u16 | by [`RejectCause`]: unknown id, wrong length, CRC, out of range, repeated, wrong sequence; wraps |
-/// | 16–17 | `lost`     | u16     | frames missing from accepted sequences, wraps      |
+/// | 4–17  | `rejected` | 7 × u16 | by [`RejectCause`]: unknown id, wrong length, CRC, out of range, repeated, wrong sequence, rate limited; wraps |
+/// | 18–19 | `lost`     | u16     | frames missing from accepted sequences, wraps      |
+///
+/// 20 bytes: exactly a CAN FD length, no padding.
 #[derive(
     Debug,
     Clone,
@@ -35,7 +38,7 @@ pub const REJECT_NAMES: [&str; 6] = [
 )]
 pub struct RejectCounters {
     /// Rejections, indexed by `RejectCause as usize`.
-    pub rejected: [Count; 6],
+    pub rejected: [Count; RejectCause::ALL.len()],
     /// Frames lost (gaps in accepted counter sequences).
     pub lost: Count,
 }

@@ -115,7 +115,7 @@ pub fn any_message() -> impl Strategy<Value = AnyMessage> {
                 )
             }
         ),
-        (proptest::array::uniform6(count()), count()).prop_map(|(rejected, lost)| {
+        (proptest::array::uniform7(count()), count()).prop_map(|(rejected, lost)| {
             AnyMessage::RejectCounters(RejectCounters { rejected, lost })
         }),
     ]

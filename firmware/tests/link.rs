@@ -1,0 +1,248 @@
+//! A lossy bus, through the node's frame handler: the link monitor lets the robot keep moving at
+//! 1 % and 5 % frame loss and brings it to a controlled stop at 20 %, refusing new motion until
+//! the link recovers.
+//!
+//! The plant is ideal (every drive reaches its target, the torso stays level); every frame to
+//! the controller goes through E2E encoding, and the bus drops every n-th frame of each
+//! identifier, so the receiver sees the gaps in each sequence.
+
+use std::collections::HashMap;
+
+use firmware::controller::Output;
+use firmware::fsm::{Direction, LegMotion, State, WheelMotion};
+use firmware::{Config, Node, Tick};
+use protocol::{
+    Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, ControllerMode, FaultFlags, Imu,
+    JointVelocity, Leg, LegFeedback, QuatComponent, SpeedScale, TeleopCommand, TeleopHeartbeat,
+    TeleopMode, Torque, WheelAngle, WheelFeedback, WheelVelocity,
+};
+
+const CONFIG: Config = Config::ROBOT;
+const TROT_F: State = State::Legs(LegMotion::Trot(Direction::Forward));
+
+/// An ideal plant and a teleop on a bus that loses every `drop_every`-th frame of each id.
+struct LossyBench {
+    node: Node,
+    now: u32,
+    joints_rad: [f32; 16],
+    /// The teleop's mode, sent every 20 ms like the real one.
+    mode: TeleopMode,
+    /// Drop every n-th frame of each identifier (`None`: a clean bus).
+    drop_every: Option<u16>,
+    /// Next rolling counter per identifier (a dropped frame still used its counter).
+    counters: HashMap<u16, u16>,
+}
+
+impl LossyBench {
+    fn new() -> Self {
+        let stance = CONFIG
+            .posture
+            .stance(
+                &CONFIG.geometry,
+                &CONFIG.limits,
+                CONFIG.posture.depth_nominal_m,
+            )
+            .unwrap()
+            .to_array();
+        let mut joints = [0.0; 16];
+        for chunk in joints.chunks_exact_mut(4) {
+            chunk.copy_from_slice(&stance);
+        }
+        Self {
+            node: Node::new(CONFIG).unwrap(),
+            now: 0,
+            joints_rad: joints,
+            mode: TeleopMode::Stop,
+            drop_every: None,
+            counters: HashMap::new(),
+        }
+    }
+
+    /// Puts `message` on the bus: encoded with its id's next counter, then delivered unless the
+    /// bus drops it.
+    fn send(&mut self, message: AnyMessage) {
+        let id = message.id().raw();
+        let counter = self.counters.entry(id).or_insert(0);
+        let frame = message.encode(*counter).unwrap();
+        *counter = counter.wrapping_add(1);
+        let dropped = self.drop_every.is_some_and(|n| *counter % n == 0);
+        if !dropped {
+            self.node
+                .on_frame(Tick(self.now), frame.id(), frame.data())
+                .unwrap_or_else(|e| panic!("{id:03X} refused: {e:?}"));
+        }
+    }
+
+    /// Asks for `mode` at once (a key press), then keeps sending it every 20 ms.
+    fn press(&mut self, mode: TeleopMode) {
+        self.mode = mode;
+        self.send(command(mode));
+    }
+
+    fn tick(&mut self) -> Output {
+        let joints_rad = self.joints_rad;
+        for (leg, chunk) in Leg::ALL.iter().zip(joints_rad.chunks_exact(4)) {
+            let mut position = [Angle::saturating_from_si(0.0); 4];
+            for (slot, value) in position.iter_mut().zip(chunk) {
+                *slot = Angle::saturating_from_si(*value);
+            }
+            self.send(AnyMessage::LegFeedback(
+                *leg,
+                LegFeedback {
+                    position,
+                    velocity: [JointVelocity::saturating_from_si(0.0); 4],
+                    effort: [Torque::saturating_from_si(0.0); 4],
+                },
+            ));
+        }
+        self.send(AnyMessage::WheelFeedback(WheelFeedback {
+            position: [WheelAngle::saturating_from_si(0.0); 2],
+            velocity: [WheelVelocity::saturating_from_si(0.0); 2],
+            effort: [Torque::saturating_from_si(0.0); 2],
+        }));
+        self.send(AnyMessage::Imu(Imu {
+            orientation: [1.0, 0.0, 0.0, 0.0].map(QuatComponent::saturating_from_si),
+            angular_rate: [AngularRate::saturating_from_si(0.0); 3],
+            acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
+        }));
+        if self.now % 5 == 0 {
+            self.send(command(self.mode));
+            self.send(AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
+                uptime: protocol::Millis::from_raw(self.now * 4).unwrap(),
+            }));
+        }
+        let (output, _) = self.node.poll(Tick(self.now));
+        if output.legs_enabled {
+            self.joints_rad = output.leg_targets_rad;
+        }
+        self.now += 1;
+        output
+    }
+
+    fn run(&mut self, ticks: u32) -> Output {
+        let mut last = self.tick();
+        for _ in 1..ticks {
+            last = self.tick();
+        }
+        last
+    }
+
+    fn state(&self) -> State {
+        self.node.controller().state()
+    }
+
+    /// A trotting robot on a clean bus.
+    fn trotting() -> Self {
+        let mut bench = Self::new();
+        bench.run(5);
+        bench.press(TeleopMode::TrotForward);
+        bench.run(300);
+        assert_eq!(bench.state(), TROT_F);
+        bench
+    }
+}
+
+fn command(mode: TeleopMode) -> AnyMessage {
+    AnyMessage::TeleopCommand(TeleopCommand {
+        mode,
+        body_height: BodyHeight::saturating_from_si(0.0),
+        speed_scale: SpeedScale::from_raw(100).unwrap(),
+    })
+}
+
+fn ticks_from_s(s: u32) -> u32 {
+    CONFIG.rate.ticks_from_ms(s * 1000)
+}
+
+#[test]
+fn one_and_five_percent_loss_keep_the_robot_trotting() {
+    for every in [100, 20] {
+        let mut bench = LossyBench::trotting();
+        bench.drop_every = Some(every);
+        for _ in 0..ticks_from_s(10) {
+            let output = bench.tick();
+            assert_eq!(
+                bench.state(),
+                TROT_F,
+                "1 in {every} lost, tick {}",
+                bench.now
+            );
+            assert!(!output.status.faults.contains(FaultFlags::LINK_DEGRADED));
+        }
+        let loss = bench.node.link().last_loss_permille().unwrap();
+        let expected = 1000 / u32::from(every);
+        // Each identifier loses whole frames per window, so the measure is only near 1/every.
+        assert!(
+            (expected * 6 / 10..=expected * 14 / 10).contains(&loss),
+            "1 in {every} lost: {loss} ‰"
+        );
+        assert!(bench.node.reject_counters().lost.raw() > 0);
+        assert_eq!(bench.node.reject_counters().total(), 0);
+    }
+}
+
+#[test]
+fn twenty_percent_loss_stops_the_trot_and_refuses_motion_until_the_link_recovers() {
+    let mut bench = LossyBench::trotting();
+    // Every 5th frame of each identifier lost: feedback still arrives every few ms, so no
+    // watchdog trips, but one frame in five is gone.
+    bench.drop_every = Some(5);
+    let mut ticks = 0;
+    while bench.state() == TROT_F {
+        bench.tick();
+        ticks += 1;
+        assert!(
+            ticks <= ticks_from_s(3),
+            "still trotting after 3 s at 20 % loss"
+        );
+    }
+    let seconds = ticks as f32 / CONFIG.rate.hz() as f32;
+    assert!(seconds <= 2.0, "stopped after {seconds} s");
+    // A controlled stop: standing on four legs, drives enabled — not a fault, not torque-free.
+    assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
+    let output = bench.tick();
+    assert!(output.legs_enabled);
+    assert_eq!(output.status.mode, ControllerMode::Stop);
+    assert!(output.status.faults.contains(FaultFlags::LINK_DEGRADED));
+    assert_eq!(
+        output.status.faults.without(FaultFlags::LINK_DEGRADED),
+        FaultFlags::EMPTY
+    );
+    // The teleop keeps resending L at 50 Hz, and a new key (W) comes through too: neither
+    // starts a motion while the link is degraded.
+    bench.run(ticks_from_s(2));
+    assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
+    bench.press(TeleopMode::WheelForward);
+    bench.run(ticks_from_s(2));
+    assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
+    assert!(bench.node.controller().link_degraded());
+    // The loss stops: within two windows the link recovers, and the robot stays put (the
+    // operator's last key is not replayed) until a new key.
+    bench.drop_every = None;
+    let output = bench.run(ticks_from_s(2) + 1);
+    assert!(!output.status.faults.contains(FaultFlags::LINK_DEGRADED));
+    assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
+    bench.press(TeleopMode::TrotForward);
+    bench.run(ticks_from_s(1));
+    assert_eq!(bench.state(), TROT_F, "requests are obeyed again");
+}
+
+#[test]
+fn twenty_percent_loss_brakes_a_wheel_drive_to_a_balanced_standstill() {
+    let mut bench = LossyBench::new();
+    bench.run(5);
+    bench.press(TeleopMode::WheelForward);
+    bench.run(ticks_from_s(2));
+    let drive = State::Wheels(WheelMotion::Drive(Direction::Forward));
+    assert_eq!(bench.state(), drive);
+    bench.drop_every = Some(5);
+    bench.run(ticks_from_s(3));
+    assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+    let output = bench.tick();
+    assert!(output.status.faults.contains(FaultFlags::LINK_DEGRADED));
+    assert_eq!(output.status.mode, ControllerMode::Stop);
+    // A new motion request is refused while the link is degraded.
+    bench.press(TeleopMode::WheelRotate);
+    bench.run(10);
+    assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+}
