@@ -13,8 +13,8 @@ use firmware::fsm::{Direction, LegMotion, State, WheelMotion};
 use firmware::{Config, Node, Tick};
 use protocol::{
     Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, ControllerMode, FaultFlags, Imu,
-    JointVelocity, Leg, LegFeedback, QuatComponent, SpeedScale, TeleopCommand, TeleopHeartbeat,
-    TeleopMode, Torque, WheelAngle, WheelFeedback, WheelVelocity,
+    JointVelocity, Leg, LegFeedback, QuatComponent, RejectCause, SpeedScale, TeleopCommand,
+    TeleopHeartbeat, TeleopMode, Torque, WheelAngle, WheelFeedback, WheelVelocity,
 };
 
 const CONFIG: Config = Config::ROBOT;
@@ -31,6 +31,9 @@ struct LossyBench {
     drop_every: Option<u16>,
     /// Next rolling counter per identifier (a dropped frame still used its counter).
     counters: HashMap<u16, u16>,
+    /// A babbling teleop: this many extra commands and heartbeats per tick, in sequence and
+    /// never lost.
+    flood_per_tick: u16,
 }
 
 impl LossyBench {
@@ -55,6 +58,7 @@ impl LossyBench {
             mode: TeleopMode::Stop,
             drop_every: None,
             counters: HashMap::new(),
+            flood_per_tick: 0,
         }
     }
 
@@ -70,6 +74,17 @@ impl LossyBench {
             self.node
                 .on_frame(Tick(self.now), frame.id(), frame.data())
                 .unwrap_or_else(|e| panic!("{id:03X} refused: {e:?}"));
+        }
+    }
+
+    /// Puts a babbler's `message` on the bus, never lost; the node may rate-limit it.
+    fn babble(&mut self, message: AnyMessage) {
+        let counter = self.counters.entry(message.id().raw()).or_insert(0);
+        let frame = message.encode(*counter).unwrap();
+        *counter = counter.wrapping_add(1);
+        match self.node.on_frame(Tick(self.now), frame.id(), frame.data()) {
+            Ok(()) | Err(protocol::DecodeError::RateLimited { .. }) => {}
+            Err(other) => panic!("babbled {:03X} refused: {other:?}", frame.id()),
         }
     }
 
@@ -108,6 +123,12 @@ impl LossyBench {
         if self.now % 5 == 0 {
             self.send(command(self.mode));
             self.send(AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
+                uptime: protocol::Millis::from_raw(self.now * 4).unwrap(),
+            }));
+        }
+        for _ in 0..self.flood_per_tick {
+            self.babble(command(self.mode));
+            self.babble(AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
                 uptime: protocol::Millis::from_raw(self.now * 4).unwrap(),
             }));
         }
@@ -245,4 +266,26 @@ fn twenty_percent_loss_brakes_a_wheel_drive_to_a_balanced_standstill() {
     bench.press(TeleopMode::WheelRotate);
     bench.run(10);
     assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+}
+
+#[test]
+fn a_babbling_teleop_does_not_hide_a_lossy_bus() {
+    let mut bench = LossyBench::trotting();
+    // 10 000 commands and 10 000 heartbeats per second, in sequence and never lost, on a bus
+    // that loses every 5th frame of everything else.
+    bench.flood_per_tick = 40;
+    bench.drop_every = Some(5);
+    bench.run(ticks_from_s(3));
+    assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
+    assert!(bench.node.controller().link_degraded());
+    let loss = bench.node.link().last_loss_permille().unwrap();
+    assert!(loss > 120, "{loss} ‰");
+    assert!(
+        bench
+            .node
+            .reject_counters()
+            .get(RejectCause::RateLimited)
+            .raw()
+            > 0
+    );
 }
