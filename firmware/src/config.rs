@@ -44,9 +44,11 @@ pub struct Config {
     pub turn: SpeedLoopGains,
     /// Balance law.
     pub balance: BalanceConfig,
-    /// Leg or wheel feedback older than this stops the robot, ms.
+    /// Leg or wheel feedback older than this stops the robot, ms. The watchdog trips on the
+    /// first tick past it, so 40 ms makes the safe stop come within 50 ms of the last frame at
+    /// 250 Hz (44 ms: 11 ticks) and at 1 kHz (41 ms).
     pub feedback_timeout_ms: u32,
-    /// IMU samples older than this stop a balancing robot, ms.
+    /// IMU samples older than this stop a balancing robot, ms (40, as the drives' feedback).
     pub imu_timeout_ms: u32,
     /// An operator silent this long is treated as a stop request, ms. 460 ms so that the robot
     /// is stopped within 500 ms of teleop dying: its last heartbeat may have gone out up to one
@@ -97,8 +99,8 @@ impl Config {
             brake_limit_m_s2: 0.8,
             wheel_viscous_nm_per_rad_s: 2.0,
         },
-        feedback_timeout_ms: 50,
-        imu_timeout_ms: 50,
+        feedback_timeout_ms: 40,
+        imu_timeout_ms: 40,
         teleop_timeout_ms: 460,
         link_window_ms: 1_000,
         link_degrade_permille: 100,
