@@ -71,7 +71,7 @@ fn closed_loop(c: &mut Criterion) {
                     for frame in teleop.frames(u64::from(cycle) * 4_000)? {
                         teleop_bus.send(&frame)?;
                     }
-                    controller.service(cycle)?;
+                    controller.service()?;
                     Ok(())
                 },
                 |_, _| true,

@@ -1,10 +1,15 @@
 //! The firmware's control core as a node on the in-process bus, stepped on the simulator's
 //! thread: the closed loop in one process, still talking only through CAN frames.
+//!
+//! The firmware keeps its own tick, one per [`InprocController::service`], as the MCU's timer
+//! does: the simulator's clock never reaches it except through SYNC frames, which it only
+//! watches to notice a simulator that restarted (its SYNC tick went back).
 
 use firmware::config::Config;
-use firmware::controller::ConfigError;
+use firmware::controller::{ConfigError, Output};
 use firmware::node::Node;
 use firmware::time::Tick;
+use protocol::{decode_frame, AnyMessage, MessageId};
 
 use firmware_host::bus::{Bus, BusError};
 use firmware_host::inproc_bus::InprocEndpoint;
@@ -15,7 +20,11 @@ use std::time::Duration;
 pub struct InprocController {
     node: Node,
     bus: InprocEndpoint,
+    tick: Tick,
     rejected: u64,
+    last_sync: Option<u32>,
+    sim_restarts: u32,
+    last_output: Option<Output>,
 }
 
 impl InprocController {
@@ -24,23 +33,51 @@ impl InprocController {
         Ok(Self {
             node: Node::new(config)?,
             bus,
+            tick: Tick(0),
             rejected: 0,
+            last_sync: None,
+            sim_restarts: 0,
+            last_output: None,
         })
     }
 
-    /// Takes every frame waiting on the bus, runs control tick `tick`, sends its frames.
-    pub fn service(&mut self, tick: u32) -> Result<(), BusError> {
-        let now = Tick(tick);
+    /// Takes every frame waiting on the bus, runs one control tick, sends its frames.
+    pub fn service(&mut self) -> Result<(), BusError> {
+        let now = self.tick;
         while let Some(frame) = self.bus.recv(Duration::ZERO)? {
             if self.node.on_frame(now, frame.id(), frame.data()).is_err() {
                 self.rejected += 1;
+                continue;
+            }
+            if frame.id() == MessageId::Sync.raw() {
+                self.watch_sync(&frame);
             }
         }
-        let (_, frames) = self.node.poll(now);
+        let (output, frames) = self.node.poll(now);
+        self.last_output = Some(output);
         for frame in &frames {
             self.bus.send(frame)?;
         }
+        self.tick = now.plus(1);
         Ok(())
+    }
+
+    fn watch_sync(&mut self, frame: &protocol::Frame) {
+        let Ok(decoded) = decode_frame(frame.id(), frame.data()) else {
+            return;
+        };
+        let AnyMessage::Sync(sync) = decoded.message else {
+            return;
+        };
+        let tick = sync.tick.raw();
+        if self.last_sync.is_some_and(|last| tick <= last) {
+            self.sim_restarts += 1;
+            tracing::warn!(
+                sync_tick = tick,
+                "the simulator restarted (its SYNC tick went back); following its new state"
+            );
+        }
+        self.last_sync = Some(tick);
     }
 
     /// The firmware node (its controller, counters).
@@ -51,5 +88,20 @@ impl InprocController {
     /// Frames the firmware rejected (by cause: [`Node::reject_counters`]).
     pub fn rejected(&self) -> u64 {
         self.rejected
+    }
+
+    /// What the last tick commanded (`None` before the first).
+    pub fn last_output(&self) -> Option<&Output> {
+        self.last_output.as_ref()
+    }
+
+    /// Times the simulator was seen to restart.
+    pub fn sim_restarts(&self) -> u32 {
+        self.sim_restarts
+    }
+
+    /// The tick the next [`InprocController::service`] computes.
+    pub fn tick(&self) -> Tick {
+        self.tick
     }
 }

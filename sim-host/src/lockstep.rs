@@ -42,45 +42,14 @@ pub fn run(
     let started = Instant::now();
     let mut stats = RunStats::default();
     for _ in 0..options.cycles {
-        let time_s = sim.time_s();
-        // Feedback first, then SYNC: a controller in another process computes the tick when
-        // SYNC arrives, with this cycle's feedback already in hand.
-        let mut outgoing = sim.frames_due()?;
-        outgoing.push(sim.sync_frame()?);
-        for frame in &outgoing {
-            bus.send(frame)?;
-            recorder.frame(time_s, frame)?;
-            stats.frames_sent += 1;
-        }
-        peers(sim.cycle())?;
-        let deadline = Instant::now() + options.reply_timeout;
-        let mut commanded = false;
-        loop {
-            let wait = if commanded {
-                Duration::ZERO
-            } else {
-                deadline.saturating_duration_since(Instant::now())
-            };
-            match bus.recv(wait)? {
-                Some(frame) => {
-                    stats.frames_received += 1;
-                    recorder.frame(time_s, &frame)?;
-                    sim.receive(&frame);
-                    commanded |= frame.id() == MessageId::WheelCommand.raw();
-                }
-                None => break,
-            }
-        }
-        if !commanded {
-            stats.missed_cycles += 1;
-        }
-        sim.advance();
-        stats.cycles += 1;
-        if !sim.physics().is_finite() {
-            return Err(RunError::Diverged {
-                time_s: sim.time_s(),
-            });
-        }
+        cycle(
+            sim,
+            bus,
+            recorder,
+            &mut stats,
+            options.reply_timeout,
+            &mut peers,
+        )?;
         recorder.row(sim.telemetry());
         if !observe(sim, &stats) {
             break;
@@ -95,4 +64,57 @@ pub fn run(
     stats.sim_s = sim.time_s();
     stats.set_wall(started.elapsed());
     Ok(stats)
+}
+
+/// One lockstep cycle: feedback and SYNC out, `peers(cycle)`, the controller's commands in
+/// (waiting up to `reply_timeout` for its WheelCommand), one physics step. Counts into `stats`;
+/// the caller records the telemetry row.
+pub fn cycle(
+    sim: &mut Simulator,
+    bus: &mut dyn Bus,
+    recorder: &mut Recorder,
+    stats: &mut RunStats,
+    reply_timeout: Duration,
+    peers: &mut impl FnMut(u32) -> Result<(), RunError>,
+) -> Result<(), RunError> {
+    let time_s = sim.time_s();
+    // Feedback first, then SYNC: a controller in another process computes the tick when
+    // SYNC arrives, with this cycle's feedback already in hand.
+    let mut outgoing = sim.frames_due()?;
+    outgoing.push(sim.sync_frame()?);
+    for frame in &outgoing {
+        bus.send(frame)?;
+        recorder.frame(time_s, frame)?;
+        stats.frames_sent += 1;
+    }
+    peers(sim.cycle())?;
+    let deadline = Instant::now() + reply_timeout;
+    let mut commanded = false;
+    loop {
+        let wait = if commanded {
+            Duration::ZERO
+        } else {
+            deadline.saturating_duration_since(Instant::now())
+        };
+        match bus.recv(wait)? {
+            Some(frame) => {
+                stats.frames_received += 1;
+                recorder.frame(time_s, &frame)?;
+                sim.receive(&frame);
+                commanded |= frame.id() == MessageId::WheelCommand.raw();
+            }
+            None => break,
+        }
+    }
+    if !commanded {
+        stats.missed_cycles += 1;
+    }
+    sim.advance();
+    stats.cycles += 1;
+    if !sim.physics().is_finite() {
+        return Err(RunError::Diverged {
+            time_s: sim.time_s(),
+        });
+    }
+    Ok(())
 }

@@ -51,6 +51,8 @@ pub fn run(
             stats.frames_sent += 1;
         }
         peers(sim.cycle())?;
+        // No SYNC in real time: the bus (its fault layer) learns of the cycle here.
+        bus.end_cycle()?;
         recorder.row(sim.telemetry());
         if !observe(sim, &stats) {
             break;

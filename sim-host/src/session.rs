@@ -24,6 +24,8 @@ use crate::run_stats::{RunError, RunStats};
 use crate::simulator::{Simulator, StartPose};
 use crate::telemetry::TelemetryRow;
 use firmware_host::bus::{Bus, BusError};
+use firmware_host::fault_plan::Faults;
+use firmware_host::faulty_bus::{FaultStats, FaultyBus};
 use firmware_host::inproc_bus::InprocBus;
 use firmware_host::socketcan_bus::SocketCanBus;
 use teleop_core::scripted::{PlanStep, ScriptedTeleop};
@@ -93,6 +95,9 @@ pub struct SessionConfig {
     pub viewer: bool,
     /// Someone outside the session on the in-process bus (the interactive teleop), or `None`.
     pub attach: Option<Attach>,
+    /// Faults on the simulator's bus connection: `tx` breaks the feedback it sends, `rx` the
+    /// commands it receives (see [`firmware_host::fault_plan`]).
+    pub faults: Faults,
 }
 
 /// An outside node's link to an in-process session: the session joins `bus` instead of making
@@ -176,6 +181,9 @@ pub struct SessionReport {
     pub interrupted: bool,
     /// Figures per segment.
     pub segments: Vec<SegmentSummary>,
+    /// What [`SessionConfig::faults`] did: to the frames the simulator sent, and to those it
+    /// received.
+    pub fault_stats: [FaultStats; 2],
 }
 
 /// Runs one session.
@@ -285,13 +293,14 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
     let has_teleop = !config.teleop_plan.is_empty();
     let period_us = 1_000_000 / u64::from(config.control_hz.max(1));
 
+    let fault_stats: [FaultStats; 2];
     let (stats, firmware_rejected) = match &config.bus {
         BusChoice::Inproc => {
             let bus = config
                 .attach
                 .as_ref()
                 .map_or_else(InprocBus::new, |a| a.bus.clone());
-            let mut sim_bus = bus.endpoint();
+            let mut sim_bus = FaultyBus::new(bus.endpoint(), &config.faults);
             let firmware = firmware_config(config.control_hz)
                 .ok_or(SessionError::ControlRate(config.control_hz))?;
             let mut controller =
@@ -303,7 +312,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
                         teleop_bus.send(&frame)?;
                     }
                 }
-                controller.service(cycle)?;
+                controller.service()?;
                 let counters = controller.node().reject_counters();
                 firmware_counters.set((
                     counters.rejected.map(|n| u64::from(n.raw())),
@@ -320,10 +329,11 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
                 peers,
                 &mut observe,
             )?;
+            fault_stats = [sim_bus.tx_stats(), sim_bus.rx_stats()];
             (stats, Some(controller.rejected()))
         }
         BusChoice::SocketCan(ifname) => {
-            let mut sim_bus = SocketCanBus::open(ifname)?;
+            let mut sim_bus = FaultyBus::new(SocketCanBus::open(ifname)?, &config.faults);
             let mut teleop_bus = if has_teleop {
                 Some(SocketCanBus::open(ifname)?)
             } else {
@@ -346,6 +356,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
                 peers,
                 &mut observe,
             )?;
+            fault_stats = [sim_bus.tx_stats(), sim_bus.rx_stats()];
             (stats, None)
         }
     };
@@ -376,6 +387,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         frames,
         interrupted,
         segments,
+        fault_stats,
     })
 }
 

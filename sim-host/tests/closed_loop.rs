@@ -21,6 +21,7 @@ fn scenario_file(name: &str) -> PathBuf {
 fn config(plan: Vec<PlanStep>, segments: Vec<SegmentSpec>, duration_s: f64) -> SessionConfig {
     SessionConfig {
         attach: None,
+        faults: Default::default(),
         model: PathBuf::from(DEFAULT_MODEL),
         bus: BusChoice::Inproc,
         clock: Clock::Lockstep,

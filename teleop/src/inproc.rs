@@ -76,6 +76,7 @@ impl InprocRobot {
             frames: None,
             viewer: false,
             attach: Some(attach),
+            faults: Default::default(),
         };
         let thread = std::thread::spawn(move || session::run(&config));
         (Self { live, stop, thread }, endpoint)

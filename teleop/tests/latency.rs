@@ -73,7 +73,7 @@ fn lockstep_latency(
             for frame in app.poll(now_ms).unwrap() {
                 teleop_bus.send(&frame)?;
             }
-            controller.service(cycle)?;
+            controller.service()?;
             // What the firmware sent in this control tick.
             while let Some(frame) = probe.recv(Duration::ZERO)? {
                 let Some(targets) = leg_targets(&frame) else {
