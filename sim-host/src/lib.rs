@@ -11,6 +11,8 @@
 pub mod candump;
 pub mod drive_core;
 pub mod error_chain;
+pub mod fault_matrix;
+pub mod fault_rig;
 pub mod hardware;
 pub mod imu;
 pub mod inproc_controller;

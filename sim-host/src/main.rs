@@ -9,6 +9,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use firmware_host::fault_plan::Faults;
 use protocol::TeleopMode;
 use sim_host::imu::ImuNoise;
 use sim_host::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
@@ -35,7 +36,18 @@ enum Command {
     /// Run the simulation.
     ///
     /// Example: sim-host run --duration 10 --drive 0:stand --drive 2:W --out out/sim
-    Run(RunArgs),
+    Run(Box<RunArgs>),
+    /// Run the fault matrix: the closed loop (in-process, lockstep) under lost, late,
+    /// duplicated, reordered, corrupted and replayed frames, a teleop flood, silent feedback, a
+    /// killed firmware, a restarted simulator and E-stops; each cell judged. Prints a Markdown
+    /// table; exits 1 if a cell fails.
+    ///
+    /// Example: sim-host faults
+    Faults {
+        /// The MJCF model.
+        #[arg(long, default_value = DEFAULT_MODEL)]
+        model: PathBuf,
+    },
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -122,6 +134,13 @@ struct RunArgs {
     /// EGL (Mesa: libegl1 libegl-mesa0 libgl1-mesa-dri). Build with `--features renderer`.
     #[arg(long, value_name = "N")]
     render_every: Option<NonZeroU32>,
+    /// Break the simulator's bus connection on purpose: `tx.*` faults hit the feedback it
+    /// sends, `rx.*` the commands it receives. Comma-separated, e.g.
+    /// `tx.drop=0.05,rx.delay=3,tx.flip=0.01,seed=7`; faults: drop, delay, duplicate, reorder,
+    /// flip, replay (probabilities 0…1, delay in control cycles), silence=NODE (`feedback`,
+    /// `Imu`, `LegDrive_FL`, …). SYNC is never faulted.
+    #[arg(long, value_name = "PLAN", default_value = "")]
+    faults: Faults,
 }
 
 fn parse_step(text: &str) -> Result<PlanStep, String> {
@@ -157,7 +176,8 @@ fn main() -> ExitCode {
     firmware_host::logging::init("info");
     let cli = Cli::parse();
     match cli.command {
-        Command::Run(args) => match run(args) {
+        Command::Faults { model } => faults(&model),
+        Command::Run(args) => match run(*args) {
             Ok(()) => ExitCode::SUCCESS,
             Err(message) => {
                 eprintln!("sim-host: {message}");
@@ -169,6 +189,26 @@ fn main() -> ExitCode {
 
 /// A flag that Ctrl-C sets, so that an interrupted run still writes its outputs. If the handler
 /// cannot be installed, Ctrl-C keeps its default effect (the process ends) and the run says so.
+fn faults(model: &std::path::Path) -> ExitCode {
+    eprintln!("running the fault matrix (about a minute in release)…");
+    match sim_host::fault_matrix::run(model) {
+        Ok(cells) => {
+            print!("{}", sim_host::fault_matrix::markdown(&cells));
+            let failed = cells.iter().filter(|c| !c.pass).count();
+            if failed == 0 {
+                ExitCode::SUCCESS
+            } else {
+                eprintln!("sim-host: {failed} of {} cells failed", cells.len());
+                ExitCode::FAILURE
+            }
+        }
+        Err(e) => {
+            eprintln!("sim-host: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
 fn stop_on_ctrl_c() -> Arc<AtomicBool> {
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
@@ -248,6 +288,7 @@ fn run(args: RunArgs) -> Result<(), String> {
         },
         teleop_plan,
         attach: None,
+        faults: args.faults.clone(),
         out_dir: Some(args.out.clone()),
         plots: !args.no_plots,
         progress: !args.no_progress,
@@ -288,6 +329,12 @@ fn run(args: RunArgs) -> Result<(), String> {
             .map(|n| format!(", {n} by the firmware"))
             .unwrap_or_default()
     );
+    if !args.faults.tx.is_clean() || !args.faults.rx.is_clean() {
+        let [tx, rx] = report.fault_stats;
+        println!("faults           {}", args.faults);
+        println!("  on feedback    {tx:?}");
+        println!("  on commands    {rx:?}");
+    }
     if let Some(row) = last {
         println!(
             "torso at end     x {:.3} m, y {:.3} m, z {:.3} m, roll {:.1}°, pitch {:.1}°, yaw {:.1}°",
