@@ -138,6 +138,14 @@ impl Process {
         }
     }
 
+    /// Kills the process outright (SIGKILL), as a crash would: no goodbye frames.
+    pub fn kill(mut self) -> std::process::ExitStatus {
+        let _ = self.child.kill();
+        self.child
+            .wait()
+            .unwrap_or_else(|e| panic!("{}: {e}", self.name))
+    }
+
     /// Asks the process to stop (SIGTERM) and waits for it.
     pub fn terminate(mut self) -> std::process::ExitStatus {
         let _ = Command::new("kill")

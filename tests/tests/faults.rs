@@ -1,0 +1,384 @@
+//! The fault matrix's vcan subset: the firmware and the simulator as two processes on a kernel
+//! vcan, the simulator's bus connection broken by `sim-host --faults`, a babbling operator
+//! flooding the bus, and the firmware killed with SIGKILL. Judged from `candump -L` (every frame
+//! as the kernel carried it), the simulator's telemetry and summary.
+
+use std::time::{Duration, Instant};
+
+use firmware_host::bus::Bus;
+use firmware_host::fault_plan::Faults;
+use firmware_host::faulty_bus::FaultyBus;
+use firmware_host::socketcan_bus::SocketCanBus;
+use hil_tests::{
+    candump, firmware, out_dir, read_candump, read_telemetry, scenario, simulate, start_sim,
+    wait_for_log, Process, Vcan,
+};
+use protocol::{
+    decode_frame, AnyMessage, BodyHeight, ControllerMode, FaultFlags, Frame, MessageId, Millis,
+    NodeId, Receiver, RejectCause, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode,
+};
+
+/// Whether the controller sent `frame`.
+fn from_controller(frame: &Frame) -> bool {
+    MessageId::from_raw(frame.id()).is_some_and(|id| id.sender() == NodeId::Controller)
+}
+
+fn controller_statuses(frames: &[(f64, Frame)]) -> Vec<(f64, protocol::ControllerStatus)> {
+    frames
+        .iter()
+        .filter_map(
+            |(t, f)| match decode_frame(f.id(), f.data()).map(|d| d.message) {
+                Ok(AnyMessage::ControllerStatus(s)) => Some((*t, s)),
+                _ => None,
+            },
+        )
+        .collect()
+}
+
+fn segment_fell(summary: &serde_json::Value) -> bool {
+    summary["segments"]
+        .as_array()
+        .is_some_and(|segments| segments.iter().any(|s| s["fell"].as_bool() != Some(false)))
+}
+
+#[test]
+fn corrupted_and_replayed_feedback_over_vcan_is_refused_frame_for_frame_and_the_trot_goes_on() {
+    let bus = Vcan::new();
+    let log = out_dir("faults-e2e").with_extension("log");
+    let dump = candump(&bus, &log);
+    std::thread::sleep(Duration::from_millis(200));
+    let fw = firmware(&bus);
+    let out = out_dir("faults-e2e-run");
+    let faults = "tx.drop=0.05,tx.flip=0.01,tx.replay=0.01,tx.duplicate=0.01,seed=4";
+    let summary = simulate(
+        &bus,
+        &out,
+        &["--scenario", &scenario("l.toml"), "--faults", faults],
+    )
+    .expect("summary");
+    let _ = fw.terminate();
+    std::thread::sleep(Duration::from_millis(100));
+    let _ = dump.terminate();
+
+    // An independent receiver over exactly what the kernel carried must refuse what the
+    // firmware refused: at each of the firmware's RejectCounters frames, its counts equal ours
+    // as of the SYNC it answered (frames after that SYNC are not yet read by the firmware).
+    let frames = read_candump(&log);
+    let mut ours = Receiver::default();
+    let mut at_sync = *ours.counters();
+    let mut compared = 0;
+    for (_, frame) in &frames {
+        if from_controller(frame) {
+            if let Ok(AnyMessage::RejectCounters(theirs)) =
+                decode_frame(frame.id(), frame.data()).map(|d| d.message)
+            {
+                assert_eq!(
+                    theirs.rejected, at_sync.rejected,
+                    "after {compared} reports"
+                );
+                compared += 1;
+            }
+            continue;
+        }
+        let _ = ours.receive(frame.id(), frame.data());
+        if frame.id() == MessageId::Sync.raw() {
+            at_sync = *ours.counters();
+        }
+    }
+    let total = ours.counters();
+    let crc = total.get(RejectCause::Crc).raw();
+    let sequence =
+        total.get(RejectCause::Repeated).raw() + total.get(RejectCause::WrongSequence).raw();
+    let forward = summary["segments"][1]["forward_m"].as_f64().unwrap_or(0.0);
+    println!(
+        "MEASURED vcan faults {faults}: firmware refused {crc} corrupted and {sequence} \
+         duplicated/replayed frames, equal to an independent receiver at all {compared} reports; \
+         L went {forward:.2} m"
+    );
+    assert!(compared > 50, "only {compared} RejectCounters frames");
+    assert!(
+        crc > 20 && sequence > 20,
+        "too few faults to judge: {crc} {sequence}"
+    );
+    assert!(forward >= 0.4, "{summary}");
+    assert!(!segment_fell(&summary), "{summary}");
+}
+
+#[test]
+fn twenty_percent_loss_over_vcan_brings_the_robot_to_a_safe_stop() {
+    let bus = Vcan::new();
+    let log = out_dir("faults-loss").with_extension("log");
+    let dump = candump(&bus, &log);
+    std::thread::sleep(Duration::from_millis(200));
+    let fw = firmware(&bus);
+    let out = out_dir("faults-loss-run");
+    let summary = simulate(
+        &bus,
+        &out,
+        &[
+            "--scenario",
+            &scenario("l.toml"),
+            "--faults",
+            "tx.drop=0.2,rx.drop=0.2,seed=9",
+        ],
+    )
+    .expect("summary");
+    let _ = fw.terminate();
+    std::thread::sleep(Duration::from_millis(100));
+    let _ = dump.terminate();
+    let statuses = controller_statuses(&read_candump(&log));
+    let degraded = statuses
+        .iter()
+        .filter(|(_, s)| s.faults.contains(FaultFlags::LINK_DEGRADED))
+        .count();
+    let trotting = statuses
+        .iter()
+        .filter(|(_, s)| s.mode == ControllerMode::TrotForward)
+        .count();
+    let forward = summary["segments"][1]["forward_m"]
+        .as_f64()
+        .unwrap_or(f64::NAN);
+    println!(
+        "MEASURED vcan 20% loss: LINK_DEGRADED in {degraded} of {} status frames, {trotting} in \
+         trot, L went {forward:.3} m",
+        statuses.len()
+    );
+    assert!(
+        degraded > statuses.len() / 2,
+        "{degraded} of {}",
+        statuses.len()
+    );
+    assert!(forward.abs() < 0.1, "{summary}");
+    assert!(!segment_fell(&summary), "{summary}");
+}
+
+fn teleop_command(mode: TeleopMode) -> AnyMessage {
+    AnyMessage::TeleopCommand(TeleopCommand {
+        mode,
+        body_height: BodyHeight::saturating_from_si(0.0),
+        speed_scale: SpeedScale::saturating_from_si(1.0),
+    })
+}
+
+/// A babbling operator: heartbeats and L at 50 Hz as a teleop sends them, plus its last command
+/// repeated by the fault layer, counters in sequence, at `rate_hz` in all, for `seconds`.
+fn flood(ifname: &str, rate_hz: f64, seconds: f64) -> u64 {
+    let socket = SocketCanBus::open(ifname).expect("open the vcan for the flood");
+    let plan: Faults = "tx.flood=1".parse().expect("plan");
+    let mut bus = FaultyBus::new(socket, &plan);
+    let started = Instant::now();
+    let mut heartbeat = protocol::E2eCounter::default();
+    let mut sent_flood = 0_u64;
+    let mut next_heartbeat = Duration::ZERO;
+    while started.elapsed().as_secs_f64() < seconds {
+        let elapsed = started.elapsed();
+        if elapsed >= next_heartbeat {
+            let uptime_ms = u32::try_from(elapsed.as_millis()).unwrap_or(u32::MAX);
+            let beat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
+                uptime: Millis::from_raw(uptime_ms).unwrap_or(Millis::saturating_from_si(0.0)),
+            })
+            .encode(heartbeat.advance())
+            .expect("heartbeat");
+            bus.send(&beat).expect("send heartbeat");
+            let command = teleop_command(TeleopMode::TrotForward)
+                .encode(1)
+                .expect("command");
+            bus.send(&command).expect("send command");
+            next_heartbeat += Duration::from_millis(20);
+        }
+        let due = (elapsed.as_secs_f64() * rate_hz) as u64;
+        while sent_flood < due {
+            bus.end_cycle().expect("flood frame");
+            sent_flood += 1;
+        }
+        std::thread::sleep(Duration::from_micros(50));
+    }
+    bus.tx_stats().flooded
+}
+
+#[test]
+fn a_10000_frames_per_second_teleop_flood_leaves_the_control_period_and_feedback_alone() {
+    let bus = Vcan::new();
+    let log = out_dir("faults-flood").with_extension("log");
+    let dump = candump(&bus, &log);
+    std::thread::sleep(Duration::from_millis(200));
+    let fw = Process::start(
+        "firmware-host",
+        &["--bus", bus.name(), "--clock", "timer", "--rate-hz", "250"],
+    );
+    let out = out_dir("faults-flood-run");
+    let sim = start_sim(bus.name(), &out, &["--mode", "realtime", "--duration", "5"]);
+    std::thread::sleep(Duration::from_millis(1000));
+    let flood_s = 3.0;
+    let flood_start = Instant::now();
+    let flooded = flood(bus.name(), 10_000.0, flood_s);
+    let achieved_hz = flooded as f64 / flood_start.elapsed().as_secs_f64();
+    assert!(sim.wait(Duration::from_secs(600)).success());
+    let _ = fw.terminate();
+    std::thread::sleep(Duration::from_millis(100));
+    let _ = dump.terminate();
+
+    let frames = read_candump(&log);
+    let teleop_times: Vec<f64> = frames
+        .iter()
+        .filter(|(_, f)| f.id() == MessageId::TeleopCommand.raw())
+        .map(|(t, _)| *t)
+        .collect();
+    let (flood_from, flood_to) = (
+        teleop_times.first().copied().unwrap_or(0.0),
+        teleop_times.last().copied().unwrap_or(0.0),
+    );
+    let mut periods: Vec<f64> = frames
+        .iter()
+        .filter(|(t, f)| {
+            f.id() == MessageId::WheelCommand.raw() && *t >= flood_from && *t <= flood_to
+        })
+        .map(|(t, _)| *t)
+        .collect::<Vec<_>>()
+        .windows(2)
+        .map(|w| (w[1] - w[0]) * 1e3)
+        .collect();
+    periods.sort_by(f64::total_cmp);
+    let p = |q: f64| {
+        periods
+            .get(((periods.len() as f64 - 1.0) * q) as usize)
+            .copied()
+            .unwrap_or(f64::NAN)
+    };
+    let statuses = controller_statuses(&frames);
+    let during: Vec<_> = statuses
+        .iter()
+        .filter(|(t, _)| *t >= flood_from && *t <= flood_to)
+        .collect();
+    let feedback_late = during
+        .iter()
+        .filter(|(_, s)| s.faults.contains(FaultFlags::FEEDBACK_TIMEOUT))
+        .count();
+    let limited = frames
+        .iter()
+        .rev()
+        .find_map(
+            |(_, f)| match decode_frame(f.id(), f.data()).map(|d| d.message) {
+                Ok(AnyMessage::RejectCounters(c)) => Some(c.get(RejectCause::RateLimited).raw()),
+                _ => None,
+            },
+        )
+        .unwrap_or(0);
+    println!(
+        "MEASURED vcan teleop flood: {flooded} frames at {achieved_hz:.0} frames/s for {flood_s} s; \
+         control period p50 {:.3} ms p99 {:.3} ms max {:.3} ms over {} periods; feedback late in \
+         {feedback_late} of {} status frames; rate-limited counter {limited} (wraps at 65536)",
+        p(0.5),
+        p(0.99),
+        p(1.0),
+        periods.len(),
+        during.len()
+    );
+    assert!(
+        periods.len() > 400,
+        "{} periods during the flood",
+        periods.len()
+    );
+    assert!((p(0.5) - 4.0).abs() < 0.4, "period p50 {}", p(0.5));
+    assert_eq!(feedback_late, 0, "the flood starved the feedback");
+    assert!(limited > 0, "no command was rate-limited");
+}
+
+#[test]
+fn a_killed_firmware_leaves_the_drives_torque_free_within_100_ms_and_they_say_timed_out() {
+    let bus = Vcan::new();
+    let log = out_dir("faults-kill").with_extension("log");
+    let dump = candump(&bus, &log);
+    std::thread::sleep(Duration::from_millis(200));
+    let fw = firmware(&bus);
+    let out = out_dir("faults-kill-run");
+    let sim = start_sim(
+        bus.name(),
+        &out,
+        &[
+            "--duration",
+            "6",
+            "--drive",
+            "0:fold",
+            "--drive",
+            "2:W",
+            "--reply-timeout-ms",
+            "30",
+        ],
+    );
+    let driving = wait_for_log(&log, Duration::from_secs(300), |frames| {
+        controller_statuses(frames)
+            .iter()
+            .rev()
+            .take(5)
+            .filter(|(_, s)| s.mode == ControllerMode::WheelForward)
+            .count()
+            >= 5
+    });
+    assert!(driving, "the robot never drove forward");
+    let _ = fw.kill();
+    assert!(sim.wait(Duration::from_secs(600)).success());
+    let _ = dump.terminate();
+
+    // The simulator's own log is in simulation time.
+    let sim_log = read_candump(&out.join("bus.log"));
+    let last_command_s = sim_log
+        .iter()
+        .filter(|(_, f)| f.id() == MessageId::WheelCommand.raw())
+        .map(|(t, _)| *t)
+        .fold(f64::NAN, f64::max);
+    let timed_out_at: Vec<f64> = protocol::Drive::ALL
+        .iter()
+        .map(|drive| {
+            sim_log
+                .iter()
+                .filter(|(t, _)| *t > last_command_s)
+                .find_map(
+                    |(t, f)| match decode_frame(f.id(), f.data()).map(|d| d.message) {
+                        Ok(AnyMessage::DriveStatus(d, s))
+                            if d == *drive && s.flags.contains(protocol::DriveFlags::TIMED_OUT) =>
+                        {
+                            Some(*t - last_command_s)
+                        }
+                        _ => None,
+                    },
+                )
+                .unwrap_or(f64::INFINITY)
+        })
+        .collect();
+    let rows = read_telemetry(&out.join("telemetry.csv"));
+    let driving_before = rows
+        .iter()
+        .filter(|(t, ..)| *t <= last_command_s)
+        .rev()
+        .take(10)
+        .any(|(_, tq, _)| tq[0].abs() > 0.1);
+    let torque_free_after = rows
+        .iter()
+        .find(|(t, tq, _)| *t > last_command_s && tq[0] == 0.0 && tq[1] == 0.0)
+        .map(|(t, ..)| t - last_command_s);
+    let stays_free = rows
+        .iter()
+        .filter(|(t, ..)| *t > last_command_s + 0.104)
+        .all(|(_, tq, _)| tq[0] == 0.0 && tq[1] == 0.0);
+    println!(
+        "MEASURED vcan firmware killed: wheels torque-free {:.0} ms after the last command; \
+         TIMED_OUT reported by the 5 drives after {:?} ms (status at 10 Hz)",
+        torque_free_after.unwrap_or(f64::NAN) * 1e3,
+        timed_out_at
+            .iter()
+            .map(|s| (s * 1e3).round())
+            .collect::<Vec<_>>()
+    );
+    assert!(
+        driving_before,
+        "the wheels were not driving before the kill"
+    );
+    assert!(
+        torque_free_after.is_some_and(|s| s <= 0.104),
+        "{torque_free_after:?}"
+    );
+    assert!(stays_free);
+    // The timeout acts at 100 ms; the status that reports it goes out at the next 10 Hz slot.
+    assert!(timed_out_at.iter().all(|s| *s <= 0.2), "{timed_out_at:?}");
+}
