@@ -257,9 +257,15 @@ pub fn cansend(bus: &Vcan, frame: &protocol::Frame) {
 
 /// Starts `candump -L <bus>` writing to `path`.
 pub fn candump(bus: &Vcan, path: &Path) -> Process {
+    candump_filtered(bus, path, "")
+}
+
+/// Starts `candump -L <bus><filter>` writing to `path`; `filter` in candump's notation, e.g.
+/// `,200~7FF` for everything but id 0x200.
+pub fn candump_filtered(bus: &Vcan, path: &Path, filter: &str) -> Process {
     let file = std::fs::File::create(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let child = Command::new(program("candump"))
-        .args(["-L", bus.name()])
+        .args(["-L", &format!("{}{filter}", bus.name())])
         .stdout(file)
         .spawn()
         .unwrap_or_else(|e| panic!("cannot run candump (can-utils): {e}"));

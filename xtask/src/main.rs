@@ -35,9 +35,10 @@ Tasks:
   bench [args]       criterion benchmarks (control step, raw MuJoCo step, closed-loop cycle), then a
                      table of medians and steps per second
                      (args go to criterion, e.g. `--measurement-time 3`)
-  hil [--vm]         the vcan hardware-in-the-loop suite: firmware and simulator as two processes
+  hil [--vm] [NAME]  the vcan hardware-in-the-loop suite: firmware and simulator as two processes
                      on a kernel vcan; natively where this kernel has vcan and you are root,
                      otherwise (or with --vm) in a QEMU VM booting a stock Debian kernel
+                     (NAME: only the tests whose name contains it, e.g. `flood`)
   firmware           build the STM32G474 image (firmware/stm32, release + LTO) and print its flash
                      and static RAM use (fails over 64 KiB flash or 16 KiB RAM)
   pil [--record]     processor-in-the-loop: the control core on QEMU's mps2-an386 (Cortex-M4F)
