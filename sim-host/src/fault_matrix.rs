@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use firmware::fsm::{LegMotion, State, WheelMotion};
-use firmware_host::fault_plan::Faults;
+use firmware_host::fault_plan::{FaultPlan, Faults, FEEDBACK_NODES};
 use protocol::{
     AnyMessage, EStop, EStopAction, FaultFlags, MessageId, NodeId, RejectCause, TeleopMode,
 };
@@ -77,8 +77,21 @@ fn step(at_s: f64, mode: TeleopMode) -> PlanStep {
 /// How long a motion cell runs, s.
 const RUN_S: f64 = 8.0;
 
-fn faults(text: &str) -> Faults {
-    text.parse().unwrap_or_default()
+/// The same faults in both directions.
+fn both(plan: FaultPlan, seed: u64) -> Faults {
+    Faults {
+        tx: plan.clone(),
+        rx: plan,
+        seed,
+    }
+}
+
+/// Faults on frames sent only.
+fn sent(plan: FaultPlan) -> Faults {
+    Faults {
+        tx: plan,
+        ..Faults::default()
+    }
 }
 
 fn fell(records: &[CycleRecord]) -> bool {
@@ -138,16 +151,16 @@ pub fn run(model: &Path) -> Result<Vec<CellResult>, SessionError> {
             cells.push(delayed(model, motion, delay, base_m)?);
         }
     }
-    cells.push(flips_and_replays(
-        model,
-        "flip",
-        "tx.flip=0.02,rx.flip=0.02,seed=5",
-    )?);
-    cells.push(flips_and_replays(
-        model,
-        "replay",
-        "tx.replay=0.02,rx.replay=0.02,seed=6",
-    )?);
+    let flips = FaultPlan {
+        flip: 0.02,
+        ..FaultPlan::default()
+    };
+    cells.push(flips_and_replays(model, "flip", both(flips, 5))?);
+    let replays = FaultPlan {
+        replay: 0.02,
+        ..FaultPlan::default()
+    };
+    cells.push(flips_and_replays(model, "replay", both(replays, 6))?);
     cells.push(flood(model)?);
     cells.push(feedback_silent(model)?);
     cells.push(firmware_killed(model)?);
@@ -163,7 +176,13 @@ fn keeps_going(
     p: f64,
     base_m: f64,
 ) -> Result<CellResult, SessionError> {
-    let plan = faults(&format!("tx.drop={p},rx.drop={p},seed=2"));
+    let plan = both(
+        FaultPlan {
+            drop: p,
+            ..FaultPlan::default()
+        },
+        2,
+    );
     let rig = run_motion(model, motion, &plan, &Faults::default())?;
     let records = rig.records();
     let distance = forward_m(records);
@@ -187,7 +206,13 @@ fn keeps_going(
 
 fn safe_stop_on_loss(model: &Path, motion: Motion) -> Result<CellResult, SessionError> {
     let start_s = 2.0;
-    let plan = faults("tx.drop=0.2,rx.drop=0.2,seed=3");
+    let plan = both(
+        FaultPlan {
+            drop: 0.2,
+            ..FaultPlan::default()
+        },
+        3,
+    );
     let mut rig = Rig::new(model, motion.plan(), &Faults::default(), &Faults::default())?;
     rig.run_until(start_s)?;
     rig.set_faults(&plan);
@@ -221,7 +246,13 @@ fn delayed(
     delay: u32,
     base_m: f64,
 ) -> Result<CellResult, SessionError> {
-    let plan = faults(&format!("tx.delay={delay},rx.delay={delay}"));
+    let plan = both(
+        FaultPlan {
+            delay_cycles: delay,
+            ..FaultPlan::default()
+        },
+        1,
+    );
     let rig = run_motion(model, motion, &plan, &Faults::default())?;
     let records = rig.records();
     let distance = forward_m(records);
@@ -241,9 +272,8 @@ fn delayed(
 fn flips_and_replays(
     model: &Path,
     what: &'static str,
-    text: &str,
+    plan: Faults,
 ) -> Result<CellResult, SessionError> {
-    let plan = faults(text);
     let rig = run_motion(model, Motion::Trot, &plan, &Faults::default())?;
     let [tx, _] = rig.fault_stats();
     let count = |cause| rig.firmware_rejected(cause);
@@ -294,7 +324,10 @@ fn flips_and_replays(
 }
 
 fn flood(model: &Path) -> Result<CellResult, SessionError> {
-    let teleop = faults("tx.flood=40");
+    let teleop = sent(FaultPlan {
+        flood_per_cycle: 40,
+        ..FaultPlan::default()
+    });
     let rig = run_motion(model, Motion::Trot, &Faults::default(), &teleop)?;
     let records = rig.records();
     let flooded = rig.teleop_fault_stats().flooded;
@@ -321,7 +354,10 @@ fn flood(model: &Path) -> Result<CellResult, SessionError> {
 
 fn feedback_silent(model: &Path) -> Result<CellResult, SessionError> {
     let start_s = 2.0;
-    let plan = faults("tx.silence=feedback");
+    let plan = sent(FaultPlan {
+        silence: FEEDBACK_NODES.to_vec(),
+        ..FaultPlan::default()
+    });
     let mut rig = Rig::new(
         model,
         Motion::Trot.plan(),
