@@ -293,73 +293,75 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
     let has_teleop = !config.teleop_plan.is_empty();
     let period_us = 1_000_000 / u64::from(config.control_hz.max(1));
 
-    let fault_stats: [FaultStats; 2];
-    let (stats, firmware_rejected) = match &config.bus {
+    // The simulator's bus and the nodes that share its thread: on the in-process bus the
+    // firmware and a scripted operator; over SocketCAN only the operator (the firmware is
+    // another process).
+    let Nodes {
+        sim: inner,
+        teleop: mut teleop_bus,
+        mut controller,
+    } = match &config.bus {
         BusChoice::Inproc => {
             let bus = config
                 .attach
                 .as_ref()
                 .map_or_else(InprocBus::new, |a| a.bus.clone());
-            let mut sim_bus = FaultyBus::new(bus.endpoint(), &config.faults);
             let firmware = firmware_config(config.control_hz)
                 .ok_or(SessionError::ControlRate(config.control_hz))?;
-            let mut controller =
+            let controller =
                 InprocController::new(firmware, bus.endpoint()).map_err(SessionError::Firmware)?;
-            let mut teleop_bus = bus.endpoint();
-            let peers = |cycle: u32| -> Result<(), RunError> {
-                if has_teleop {
-                    for frame in teleop.frames(u64::from(cycle) * period_us)? {
-                        teleop_bus.send(&frame)?;
-                    }
-                }
-                controller.service()?;
-                let counters = controller.node().reject_counters();
-                firmware_counters.set((
-                    counters.rejected.map(|n| u64::from(n.raw())),
-                    u64::from(counters.lost.raw()),
-                ));
-                Ok(())
-            };
-            let stats = drive(
-                &mut sim,
-                &mut sim_bus,
-                &mut recorder,
-                config,
-                cycles,
-                peers,
-                &mut observe,
-            )?;
-            fault_stats = [sim_bus.tx_stats(), sim_bus.rx_stats()];
-            (stats, Some(controller.rejected()))
-        }
-        BusChoice::SocketCan(ifname) => {
-            let mut sim_bus = FaultyBus::new(SocketCanBus::open(ifname)?, &config.faults);
-            let mut teleop_bus = if has_teleop {
-                Some(SocketCanBus::open(ifname)?)
+            let teleop: Option<Box<dyn Bus>> = if has_teleop {
+                Some(Box::new(bus.transmitter()))
             } else {
                 None
             };
-            let peers = |cycle: u32| -> Result<(), RunError> {
-                if let Some(bus) = &mut teleop_bus {
-                    for frame in teleop.frames(u64::from(cycle) * period_us)? {
-                        bus.send(&frame)?;
-                    }
-                }
-                Ok(())
+            Nodes {
+                sim: Box::new(bus.endpoint()),
+                teleop,
+                controller: Some(controller),
+            }
+        }
+        BusChoice::SocketCan(ifname) => {
+            let teleop: Option<Box<dyn Bus>> = if has_teleop {
+                Some(Box::new(SocketCanBus::open(ifname)?))
+            } else {
+                None
             };
-            let stats = drive(
-                &mut sim,
-                &mut sim_bus,
-                &mut recorder,
-                config,
-                cycles,
-                peers,
-                &mut observe,
-            )?;
-            fault_stats = [sim_bus.tx_stats(), sim_bus.rx_stats()];
-            (stats, None)
+            Nodes {
+                sim: Box::new(SocketCanBus::open(ifname)?),
+                teleop,
+                controller: None,
+            }
         }
     };
+    let mut sim_bus = FaultyBus::new(inner, &config.faults);
+    let peers = |cycle: u32| -> Result<(), RunError> {
+        if let Some(bus) = &mut teleop_bus {
+            for frame in teleop.frames(u64::from(cycle) * period_us)? {
+                bus.send(&frame)?;
+            }
+        }
+        if let Some(controller) = &mut controller {
+            controller.service()?;
+            let counters = controller.node().reject_counters();
+            firmware_counters.set((
+                counters.rejected.map(|n| u64::from(n.raw())),
+                u64::from(counters.lost.raw()),
+            ));
+        }
+        Ok(())
+    };
+    let stats = drive(
+        &mut sim,
+        &mut sim_bus,
+        &mut recorder,
+        config,
+        cycles,
+        peers,
+        &mut observe,
+    )?;
+    let fault_stats = [sim_bus.tx_stats(), sim_bus.rx_stats()];
+    let firmware_rejected = controller.as_ref().map(InprocController::rejected);
     progress.finish_and_clear();
     if let Some((_, done)) = tracker.take() {
         segments.push(done.finish());
@@ -389,6 +391,15 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         segments,
         fault_stats,
     })
+}
+
+/// The simulator's connection to the bus and the nodes that run on its thread.
+struct Nodes {
+    sim: Box<dyn Bus>,
+    /// The scripted operator's connection (send only), if it has a plan.
+    teleop: Option<Box<dyn Bus>>,
+    /// The firmware, on the in-process bus only.
+    controller: Option<InprocController>,
 }
 
 /// What watches a run besides the progress bar: frames (feature `renderer`) and the viewer

@@ -84,3 +84,26 @@ pub trait Bus {
     /// A name for logs (`vcan0`, `inproc`).
     fn name(&self) -> &str;
 }
+
+/// A boxed bus is a bus, so that one code path can drive whichever bus the user chose.
+impl<B: Bus + ?Sized> Bus for Box<B> {
+    fn send(&mut self, frame: &Frame) -> Result<(), BusError> {
+        (**self).send(frame)
+    }
+
+    fn recv(&mut self, timeout: Duration) -> Result<Option<Frame>, BusError> {
+        (**self).recv(timeout)
+    }
+
+    fn foreign_frames(&self) -> u64 {
+        (**self).foreign_frames()
+    }
+
+    fn end_cycle(&mut self) -> Result<(), BusError> {
+        (**self).end_cycle()
+    }
+
+    fn name(&self) -> &str {
+        (**self).name()
+    }
+}

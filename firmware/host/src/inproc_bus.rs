@@ -25,7 +25,8 @@ pub struct InprocBus {
 #[derive(Debug)]
 pub struct InprocEndpoint {
     shared: Arc<(Mutex<Shared>, Condvar)>,
-    index: usize,
+    /// Its receive queue; `None` for a node that only sends.
+    index: Option<usize>,
 }
 
 impl InprocBus {
@@ -40,7 +41,16 @@ impl InprocBus {
         shared.queues.push(VecDeque::new());
         InprocEndpoint {
             shared: Arc::clone(&self.shared),
-            index: shared.queues.len() - 1,
+            index: Some(shared.queues.len() - 1),
+        }
+    }
+
+    /// Attaches a node that only sends (a scripted operator, a tool): it has no receive queue,
+    /// so frames do not pile up for a reader that never comes. Its `recv` never returns a frame.
+    pub fn transmitter(&self) -> InprocEndpoint {
+        InprocEndpoint {
+            shared: Arc::clone(&self.shared),
+            index: None,
         }
     }
 }
@@ -58,7 +68,7 @@ impl Bus for InprocEndpoint {
         let (mutex, ready) = &*self.shared;
         let mut shared = lock(mutex);
         for (i, queue) in shared.queues.iter_mut().enumerate() {
-            if i != self.index {
+            if Some(i) != self.index {
                 queue.push_back(*frame);
             }
         }
@@ -67,15 +77,15 @@ impl Bus for InprocEndpoint {
     }
 
     fn recv(&mut self, timeout: Duration) -> Result<Option<Frame>, BusError> {
+        let Some(index) = self.index else {
+            std::thread::sleep(timeout);
+            return Ok(None);
+        };
         let (mutex, ready) = &*self.shared;
         let deadline = Instant::now() + timeout;
         let mut shared = lock(mutex);
         loop {
-            if let Some(frame) = shared
-                .queues
-                .get_mut(self.index)
-                .and_then(VecDeque::pop_front)
-            {
+            if let Some(frame) = shared.queues.get_mut(index).and_then(VecDeque::pop_front) {
                 return Ok(Some(frame));
             }
             let now = Instant::now();
@@ -119,6 +129,20 @@ mod tests {
         assert_eq!(b.recv(none).unwrap(), None);
         assert_eq!(a.recv(none).unwrap(), Some(frame(0x180, 2)));
         assert_eq!(a.recv(none).unwrap(), None);
+    }
+
+    #[test]
+    fn a_transmitter_sends_to_all_and_keeps_nothing() {
+        let bus = InprocBus::new();
+        let mut rx = bus.endpoint();
+        let mut tx = bus.transmitter();
+        let mut other = bus.endpoint();
+        other.send(&frame(0x101, 1)).unwrap();
+        tx.send(&frame(0x200, 2)).unwrap();
+        assert_eq!(rx.recv(Duration::ZERO).unwrap(), Some(frame(0x101, 1)));
+        assert_eq!(rx.recv(Duration::ZERO).unwrap(), Some(frame(0x200, 2)));
+        assert_eq!(tx.recv(Duration::ZERO).unwrap(), None);
+        assert_eq!(lock(&bus.shared.0).queues.len(), 2);
     }
 
     #[test]
