@@ -126,6 +126,13 @@ fn run_motion(
     Ok(rig)
 }
 
+/// `motion` on a clean bus until `until_s`, for a cell that breaks something then.
+fn clean_until(model: &Path, motion: Motion, until_s: f64) -> Result<Rig, SessionError> {
+    let mut rig = Rig::new(model, motion.plan(), &Faults::default(), &Faults::default())?;
+    rig.run_until(until_s)?;
+    Ok(rig)
+}
+
 /// Runs every cell on `model`.
 pub fn run(model: &Path) -> Result<Vec<CellResult>, SessionError> {
     let clean = Faults::default();
@@ -144,11 +151,27 @@ pub fn run(model: &Path) -> Result<Vec<CellResult>, SessionError> {
             pass: !fell(baseline.records()) && base_m > 0.5,
         });
         for p in [0.01, 0.05] {
-            cells.push(keeps_going(model, motion, p, base_m)?);
+            let plan = both(
+                FaultPlan {
+                    drop: p,
+                    ..FaultPlan::default()
+                },
+                2,
+            );
+            let what = format!("loss {:.0}%", p * 100.0);
+            cells.push(keeps_going(model, motion, &what, &plan, base_m)?);
         }
         cells.push(safe_stop_on_loss(model, motion)?);
         for delay in 1..=3 {
-            cells.push(delayed(model, motion, delay, base_m)?);
+            let plan = both(
+                FaultPlan {
+                    delay_cycles: delay,
+                    ..FaultPlan::default()
+                },
+                1,
+            );
+            let what = format!("delay {delay} cycles each way");
+            cells.push(keeps_going(model, motion, &what, &plan, base_m)?);
         }
     }
     let flips = FaultPlan {
@@ -170,35 +193,34 @@ pub fn run(model: &Path) -> Result<Vec<CellResult>, SessionError> {
     Ok(cells)
 }
 
+/// A motion under `plan` from the start: it must keep going, at least 60 % as far as on a
+/// clean bus, and not fall.
 fn keeps_going(
     model: &Path,
     motion: Motion,
-    p: f64,
+    what: &str,
+    plan: &Faults,
     base_m: f64,
 ) -> Result<CellResult, SessionError> {
-    let plan = both(
-        FaultPlan {
-            drop: p,
-            ..FaultPlan::default()
-        },
-        2,
-    );
-    let rig = run_motion(model, motion, &plan, &Faults::default())?;
+    let rig = run_motion(model, motion, plan, &Faults::default())?;
     let records = rig.records();
     let distance = forward_m(records);
     let still = records.last().is_some_and(|r| motion.moving(r.state));
     let [tx, rx] = rig.fault_stats();
+    let dropped = if tx.dropped + rx.dropped > 0 {
+        format!(", {} + {} frames dropped", tx.dropped, rx.dropped)
+    } else {
+        String::new()
+    };
     Ok(CellResult {
-        name: format!("{}, loss {:.0}%", motion.name(), p * 100.0),
+        name: format!("{}, {what}", motion.name()),
         fault: plan.to_string(),
         expected: "keeps going, no fall",
         measured: format!(
-            "{distance:.2} m ({:.0}% of clean), still {}, max tilt {:.1}°, {} + {} frames dropped",
+            "{distance:.2} m ({:.0}% of clean), still {}, max tilt {:.1}°{dropped}",
             100.0 * distance / base_m,
             if still { "moving" } else { "STOPPED" },
             max_tilt_deg(records),
-            tx.dropped,
-            rx.dropped
         ),
         pass: still && !fell(records) && distance > 0.6 * base_m,
     })
@@ -213,8 +235,7 @@ fn safe_stop_on_loss(model: &Path, motion: Motion) -> Result<CellResult, Session
         },
         3,
     );
-    let mut rig = Rig::new(model, motion.plan(), &Faults::default(), &Faults::default())?;
-    rig.run_until(start_s)?;
+    let mut rig = clean_until(model, motion, start_s)?;
     rig.set_faults(&plan);
     rig.run_until(RUN_S)?;
     let after = records_from(rig.records(), start_s);
@@ -237,35 +258,6 @@ fn safe_stop_on_loss(model: &Path, motion: Motion) -> Result<CellResult, Session
         expected: "degrades to a safe stop, no fall",
         measured,
         pass: stopped_at.is_some() && !fell(after) && creep_m < 0.05,
-    })
-}
-
-fn delayed(
-    model: &Path,
-    motion: Motion,
-    delay: u32,
-    base_m: f64,
-) -> Result<CellResult, SessionError> {
-    let plan = both(
-        FaultPlan {
-            delay_cycles: delay,
-            ..FaultPlan::default()
-        },
-        1,
-    );
-    let rig = run_motion(model, motion, &plan, &Faults::default())?;
-    let records = rig.records();
-    let distance = forward_m(records);
-    Ok(CellResult {
-        name: format!("{}, delay {delay} cycles each way", motion.name()),
-        fault: plan.to_string(),
-        expected: "no fall",
-        measured: format!(
-            "{distance:.2} m ({:.0}% of clean), max tilt {:.1}°",
-            100.0 * distance / base_m,
-            max_tilt_deg(records)
-        ),
-        pass: !fell(records),
     })
 }
 
@@ -358,13 +350,7 @@ fn feedback_silent(model: &Path) -> Result<CellResult, SessionError> {
         silence: FEEDBACK_NODES.to_vec(),
         ..FaultPlan::default()
     });
-    let mut rig = Rig::new(
-        model,
-        Motion::Trot.plan(),
-        &Faults::default(),
-        &Faults::default(),
-    )?;
-    rig.run_until(start_s)?;
+    let mut rig = clean_until(model, Motion::Trot, start_s)?;
     rig.set_faults(&plan);
     rig.run_until(start_s + 1.0)?;
     let after = records_from(rig.records(), start_s);
@@ -390,13 +376,7 @@ fn feedback_silent(model: &Path) -> Result<CellResult, SessionError> {
 
 fn firmware_killed(model: &Path) -> Result<CellResult, SessionError> {
     let kill_s = 2.0;
-    let mut rig = Rig::new(
-        model,
-        Motion::Trot.plan(),
-        &Faults::default(),
-        &Faults::default(),
-    )?;
-    rig.run_until(kill_s)?;
+    let mut rig = clean_until(model, Motion::Trot, kill_s)?;
     rig.kill_firmware();
     rig.run_until(kill_s + 0.5)?;
     let records = rig.records();
@@ -444,13 +424,7 @@ fn max_target_step(records: &[CycleRecord]) -> f32 {
 
 fn simulator_restarted(model: &Path) -> Result<CellResult, SessionError> {
     let restart_s = 3.0;
-    let mut rig = Rig::new(
-        model,
-        Motion::Trot.plan(),
-        &Faults::default(),
-        &Faults::default(),
-    )?;
-    rig.run_until(restart_s)?;
+    let mut rig = clean_until(model, Motion::Trot, restart_s)?;
     rig.restart_simulator()?;
     rig.run_until(restart_s + 3.0)?;
     let before = max_target_step(
@@ -496,13 +470,7 @@ fn simulator_restarted(model: &Path) -> Result<CellResult, SessionError> {
 fn estop(model: &Path, from: NodeId) -> Result<CellResult, SessionError> {
     let latch_s = 2.0;
     let clear_s = 4.0;
-    let mut rig = Rig::new(
-        model,
-        Motion::Trot.plan(),
-        &Faults::default(),
-        &Faults::default(),
-    )?;
-    rig.run_until(latch_s)?;
+    let mut rig = clean_until(model, Motion::Trot, latch_s)?;
     // A teleop counts its E-stops; `cansend` sends a fixed frame (counter 0), every time.
     let counter = if from == NodeId::Teleop { 1 } else { 0 };
     let latch = AnyMessage::EStop(EStop {

@@ -101,8 +101,8 @@ impl Rig {
         let firmware = firmware_config(RIG_HZ).ok_or(SessionError::ControlRate(RIG_HZ))?;
         let controller =
             InprocController::new(firmware, bus.endpoint()).map_err(SessionError::Firmware)?;
-        let teleop_bus = FaultyBus::new(bus.endpoint(), teleop_faults);
-        let tool = bus.endpoint();
+        let teleop_bus = FaultyBus::new(bus.transmitter(), teleop_faults);
+        let tool = bus.transmitter();
         Ok(Self {
             model: model.to_owned(),
             sim,
