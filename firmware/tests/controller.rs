@@ -1,6 +1,10 @@
 //! The control step against an ideal plant (every drive reaches its target, the torso stays
 //! level): transitions, watchdogs, the E-stop latch, and the safety clamp under arbitrary input.
 
+mod common;
+
+use common::Ticks;
+
 use firmware::controller::Output;
 use firmware::fsm::{LegMotion, State, WheelMotion};
 use firmware::{Config, Controller, Tick};
@@ -63,19 +67,7 @@ fn estop(action: EStopAction) -> AnyMessage {
 impl Bench {
     fn new() -> Self {
         // Start on the legs, roughly standing.
-        let stance = CONFIG
-            .posture
-            .stance(
-                &CONFIG.geometry,
-                &CONFIG.limits,
-                CONFIG.posture.depth_nominal_m,
-            )
-            .unwrap()
-            .to_array();
-        let mut joints = [0.0; 16];
-        for chunk in joints.chunks_exact_mut(4) {
-            chunk.copy_from_slice(&stance);
-        }
+        let joints = common::standing_joints_rad(&CONFIG);
         Self {
             controller: Controller::new(CONFIG).unwrap(),
             now: 0,
@@ -127,16 +119,14 @@ impl Bench {
         output
     }
 
-    fn run(&mut self, ticks: u32) -> Output {
-        let mut last = self.tick();
-        for _ in 1..ticks {
-            last = self.tick();
-        }
-        last
-    }
-
     fn state(&self) -> State {
         self.controller.state()
+    }
+}
+
+impl Ticks for Bench {
+    fn tick(&mut self) -> Output {
+        Bench::tick(self)
     }
 }
 

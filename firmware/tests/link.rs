@@ -6,6 +6,10 @@
 //! the controller goes through E2E encoding, and the bus drops every n-th frame of each
 //! identifier, so the receiver sees the gaps in each sequence.
 
+mod common;
+
+use common::Ticks;
+
 use std::collections::HashMap;
 
 use firmware::controller::Output;
@@ -38,19 +42,7 @@ struct LossyBench {
 
 impl LossyBench {
     fn new() -> Self {
-        let stance = CONFIG
-            .posture
-            .stance(
-                &CONFIG.geometry,
-                &CONFIG.limits,
-                CONFIG.posture.depth_nominal_m,
-            )
-            .unwrap()
-            .to_array();
-        let mut joints = [0.0; 16];
-        for chunk in joints.chunks_exact_mut(4) {
-            chunk.copy_from_slice(&stance);
-        }
+        let joints = common::standing_joints_rad(&CONFIG);
         Self {
             node: Node::new(CONFIG).unwrap(),
             now: 0,
@@ -140,14 +132,6 @@ impl LossyBench {
         output
     }
 
-    fn run(&mut self, ticks: u32) -> Output {
-        let mut last = self.tick();
-        for _ in 1..ticks {
-            last = self.tick();
-        }
-        last
-    }
-
     fn state(&self) -> State {
         self.node.controller().state()
     }
@@ -160,6 +144,12 @@ impl LossyBench {
         bench.run(300);
         assert_eq!(bench.state(), TROT_F);
         bench
+    }
+}
+
+impl Ticks for LossyBench {
+    fn tick(&mut self) -> Output {
+        LossyBench::tick(self)
     }
 }
 
