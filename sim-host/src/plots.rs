@@ -6,6 +6,7 @@ use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
@@ -253,13 +254,7 @@ fn time_chart<DB: DrawingBackend>(
             .label(line.label)
             .legend(move |(x, y)| PathElement::new([(x, y), (x + LEGEND_LINE_PX, y)], style));
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font((FONT, TEXT_PX))
-        .draw()
+    draw_legend(&mut chart)
 }
 
 fn trajectory_chart<DB: DrawingBackend>(
@@ -313,6 +308,13 @@ fn trajectory_chart<DB: DrawingBackend>(
                 });
         }
     }
+    draw_legend(&mut chart)
+}
+
+/// The legend box, upper right, as every chart here draws it.
+fn draw_legend<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+) -> DrawResult<DB> {
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperRight)
