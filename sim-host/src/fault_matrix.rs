@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use firmware::fsm::{LegMotion, State, WheelMotion};
-use firmware_host::fault_plan::{FaultPlan, Faults, FEEDBACK_NODES};
+use firmware_host::fault_plan::{feedback_nodes, FaultPlan, Faults};
 use protocol::{
     AnyMessage, EStop, EStopAction, FaultFlags, MessageId, NodeId, RejectCause, TeleopMode,
 };
@@ -347,7 +347,7 @@ fn flood(model: &Path) -> Result<CellResult, SessionError> {
 fn feedback_silent(model: &Path) -> Result<CellResult, SessionError> {
     let start_s = 2.0;
     let plan = sent(FaultPlan {
-        silence: FEEDBACK_NODES.to_vec(),
+        silence: feedback_nodes(),
         ..FaultPlan::default()
     });
     let mut rig = clean_until(model, Motion::Trot, start_s)?;

@@ -19,6 +19,7 @@ use crate::drive_core::{Authority, DriveCore};
 use crate::imu::ImuNoise;
 use crate::inproc_controller::InprocController;
 use crate::lockstep;
+use crate::metrics::FALLEN_TILT_DEG;
 use crate::recorder::Recorder;
 use crate::run_stats::{RunError, RunStats};
 use crate::session::{firmware_config, SessionError};
@@ -59,9 +60,10 @@ pub struct CycleRecord {
 }
 
 impl CycleRecord {
-    /// Fallen: tilted past 45° or the torso on the ground.
+    /// Fallen, as the run summaries judge it: tilted past [`FALLEN_TILT_DEG`] or the torso on
+    /// the ground.
     pub fn fallen(&self) -> bool {
-        self.tilt_deg > 45.0 || self.torso_contact
+        self.tilt_deg > FALLEN_TILT_DEG || self.torso_contact
     }
 }
 

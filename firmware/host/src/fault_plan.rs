@@ -22,7 +22,7 @@
 use std::fmt;
 use std::str::FromStr;
 
-use protocol::{MessageId, NodeId};
+use protocol::{Drive, MessageId, NodeId};
 
 /// The faults of one direction.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -108,14 +108,13 @@ fn node_names() -> String {
 }
 
 /// The nodes `feedback` stands for: every drive and the IMU.
-pub const FEEDBACK_NODES: [NodeId; 6] = [
-    NodeId::LegDriveFl,
-    NodeId::LegDriveFr,
-    NodeId::LegDriveBl,
-    NodeId::LegDriveBr,
-    NodeId::WheelDrive,
-    NodeId::Imu,
-];
+pub fn feedback_nodes() -> Vec<NodeId> {
+    Drive::ALL
+        .iter()
+        .map(|drive| drive.node())
+        .chain([NodeId::Imu])
+        .collect()
+}
 
 impl FromStr for Faults {
     type Err = FaultPlanError;
@@ -160,7 +159,7 @@ impl FromStr for Faults {
                 "flip" => plan.flip = probability()?,
                 "replay" => plan.replay = probability()?,
                 "flood" => plan.flood_per_cycle = count()?,
-                "silence" if value == "feedback" => plan.silence.extend(FEEDBACK_NODES),
+                "silence" if value == "feedback" => plan.silence.extend(feedback_nodes()),
                 "silence" => plan.silence.push(
                     NodeId::ALL
                         .into_iter()
@@ -196,7 +195,7 @@ impl fmt::Display for Faults {
             if plan.flood_per_cycle > 0 {
                 items.push(format!("{direction}.flood={}", plan.flood_per_cycle));
             }
-            if plan.silence == FEEDBACK_NODES {
+            if plan.silence == feedback_nodes() {
                 items.push(format!("{direction}.silence=feedback"));
             } else {
                 for node in &plan.silence {
@@ -237,7 +236,8 @@ mod tests {
     #[test]
     fn feedback_silences_every_drive_and_the_imu() {
         let faults: Faults = "tx.silence=feedback".parse().unwrap();
-        assert_eq!(faults.tx.silence, FEEDBACK_NODES);
+        assert_eq!(faults.tx.silence, feedback_nodes());
+        assert_eq!(faults.tx.silence.len(), 6);
         assert!(faults.rx.is_clean());
     }
 
