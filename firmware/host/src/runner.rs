@@ -53,7 +53,8 @@ pub struct RunnerStats {
     /// Frames the firmware rejected, by cause, in [`RejectCause::ALL`] order (unknown id, wrong
     /// length, CRC, out of range, repeated, wrong sequence, rate limited).
     pub rejected: [u64; RejectCause::ALL.len()],
-    /// Timer mode: ticks that started later than one period after their deadline.
+    /// Timer mode: ticks lost because the runner fell more than a period behind (the tick
+    /// counter then runs slow, as on the MCU, instead of catching up in a burst).
     pub overruns: u64,
 }
 
@@ -153,6 +154,8 @@ fn timer(
     let period = Duration::from_nanos(1_000_000_000 / u64::from(rate.hz()));
     let start = Instant::now();
     let mut tick = Tick(0);
+    // The wall-clock period this tick runs in: tick `n` is due at `start + slot * period`.
+    let mut slot: u64 = 0;
     while !done(&config, stats, stop) {
         while let Some(frame) = bus.recv(Duration::ZERO)? {
             stats.frames_in += 1;
@@ -166,11 +169,8 @@ fn timer(
         stats.ticks += 1;
         tick = tick.plus(1);
         bus.end_cycle()?;
-        let deadline = start + period * u32::try_from(stats.ticks).unwrap_or(u32::MAX);
-        let now = Instant::now();
-        if now > deadline + period {
-            stats.overruns += 1;
-        }
+        slot = next_slot(slot, start.elapsed(), period, &mut stats.overruns);
+        let deadline = start + period * u32::try_from(slot).unwrap_or(u32::MAX);
         // Wait for the next tick, taking frames as they come so that they are timely.
         while let Some(left) = deadline.checked_duration_since(Instant::now()) {
             if left.is_zero() {
@@ -183,6 +183,22 @@ fn timer(
         }
     }
     Ok(())
+}
+
+/// The period the next tick runs in, after one ran in `slot` and `elapsed` has passed since
+/// the start. As the MCU's SysTick loop does, a runner that fell more than a period behind
+/// runs one tick at once and loses the ones in between (counted in `lost`) rather than
+/// bunching them up: the core measures every timeout in ticks, and a burst of ticks with no
+/// frames between them would age the feedback read just before it by the length of the stall.
+fn next_slot(slot: u64, elapsed: Duration, period: Duration, lost: &mut u64) -> u64 {
+    let next = slot + 1;
+    let now = u64::try_from(elapsed.as_nanos() / period.as_nanos().max(1)).unwrap_or(u64::MAX);
+    if now > next {
+        *lost += now - next;
+        now
+    } else {
+        next
+    }
 }
 
 /// Zero wheel torque and torque-free legs, in sequence with the node's commands, so that the

@@ -3,9 +3,9 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
-use firmware_host::bus::Bus;
+use firmware_host::bus::{Bus, BusError};
 use firmware_host::inproc_bus::InprocBus;
 use firmware_host::runner::{self, Clock, RunnerConfig};
 use protocol::{AnyMessage, DriveEnable, E2eCounter, MessageId, Receiver, Sync, Tick};
@@ -112,4 +112,75 @@ fn timer_mode_keeps_its_own_time() {
     }
     // One per tick, plus the stop.
     assert_eq!(wheel_commands, 26);
+}
+
+/// A bus whose owner is descheduled for `stall` once, after `stall_after` cycles, and that
+/// notes when each wheel command went out.
+struct StallingBus<B> {
+    inner: B,
+    cycles: u32,
+    stall_after: u32,
+    stall: Duration,
+    wheel_commands_at: Vec<Instant>,
+}
+
+impl<B: Bus> Bus for StallingBus<B> {
+    fn send(&mut self, frame: &protocol::Frame) -> Result<(), BusError> {
+        if frame.id() == MessageId::WheelCommand.raw() {
+            self.wheel_commands_at.push(Instant::now());
+        }
+        self.inner.send(frame)
+    }
+    fn recv(&mut self, timeout: Duration) -> Result<Option<protocol::Frame>, BusError> {
+        self.inner.recv(timeout)
+    }
+    fn end_cycle(&mut self) -> Result<(), BusError> {
+        self.cycles += 1;
+        if self.cycles == self.stall_after {
+            std::thread::sleep(self.stall);
+        }
+        Ok(())
+    }
+    fn name(&self) -> &str {
+        self.inner.name()
+    }
+}
+
+#[test]
+fn a_stalled_timer_loses_the_missed_ticks_instead_of_bunching_them_up() {
+    let bus = InprocBus::new();
+    let mut stalling = StallingBus {
+        inner: bus.endpoint(),
+        cycles: 0,
+        stall_after: 5,
+        stall: Duration::from_millis(60),
+        wheel_commands_at: Vec::new(),
+    };
+    let stats = runner::run(
+        &mut stalling,
+        RunnerConfig {
+            clock: Clock::Timer,
+            control_hz: 250,
+            max_ticks: Some(20),
+            idle_timeout: None,
+        },
+        &AtomicBool::new(false),
+    )
+    .unwrap();
+    assert_eq!(stats.ticks, 20);
+    // 60 ms is 15 periods: the one due at once runs, at least 14 are lost.
+    assert!(stats.overruns >= 14, "{} ticks lost", stats.overruns);
+    // Never three commands within 2 ms: bunched catch-up ticks would send 15 at once (the last
+    // command is the stop, sent right after the last tick, so it is left out).
+    let sent = &stalling.wheel_commands_at[..20];
+    let bunched = sent
+        .windows(3)
+        .filter(|w| w[2].duration_since(w[0]) < Duration::from_millis(2))
+        .count();
+    assert_eq!(
+        bunched,
+        0,
+        "{:?}",
+        sent.windows(2).map(|w| w[1] - w[0]).collect::<Vec<_>>()
+    );
 }
