@@ -13,6 +13,8 @@ use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
+use firmware_host::socketcan_bus::RECEIVE_BUFFER_BYTES;
+
 /// The workspace root.
 pub fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -261,11 +263,14 @@ pub fn candump(bus: &Vcan, path: &Path) -> Process {
 }
 
 /// Starts `candump -L <bus><filter>` writing to `path`; `filter` in candump's notation, e.g.
-/// `,200~7FF` for everything but id 0x200.
+/// `,200~7FF` for everything but id 0x200. Its socket buffer is as large as the nodes' (see
+/// `firmware_host::socketcan_bus::RECEIVE_BUFFER_BYTES`): the log is the tests' evidence, and a
+/// candump descheduled on a busy VM must not drop what the nodes received.
 pub fn candump_filtered(bus: &Vcan, path: &Path, filter: &str) -> Process {
     let file = std::fs::File::create(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let child = Command::new(program("candump"))
-        .args(["-L", &format!("{}{filter}", bus.name())])
+        .args(["-L", "-r", &RECEIVE_BUFFER_BYTES.to_string()])
+        .arg(format!("{}{filter}", bus.name()))
         .stdout(file)
         .spawn()
         .unwrap_or_else(|e| panic!("cannot run candump (can-utils): {e}"));

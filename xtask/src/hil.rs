@@ -296,6 +296,7 @@ fn initramfs(kernel: &Kernel, suite: &[PathBuf], filter: &str) -> Result<PathBuf
          export PATH=/bin:{tools}\n\
          mount -t proc proc /proc; mount -t sysfs sys /sys; mount -t devtmpfs dev /dev\n\
          for m in {modules}; do insmod $m || echo \"hil: insmod $m failed\"; done\n\
+         echo 4194304 > /proc/sys/net/core/rmem_max\n\
          echo \"hil: kernel $(uname -r), $(grep -c processor /proc/cpuinfo) CPUs\"\n\
          status=0\n\
          for suite in {suite}; do HIL_BIN_DIR={release} HIL_EXPORT_DIR=/export $suite {filter} --test-threads 2 --show-output || status=1; done\n\

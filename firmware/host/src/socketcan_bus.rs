@@ -48,11 +48,38 @@ impl SocketCanBus {
             }
         }
         let socket = CanFdSocket::open(ifname).map_err(|source| classify(ifname, source))?;
+        reserve_receive_buffer(&socket, ifname);
         Ok(Self {
             socket,
             ifname: ifname.to_owned(),
             foreign: 0,
         })
+    }
+}
+
+/// Receive buffer asked of the kernel, bytes. A host process can be descheduled for tens of
+/// milliseconds, and every frame that arrives meanwhile must wait in the socket: at the 10 000
+/// frames/s of a flood a 100 ms stall is 1 000 frames, each of which costs the kernel about 1 KiB
+/// of buffer. The default (`net.core.rmem_default`, some 200 KiB) would drop frames from every
+/// node, the drives' feedback included; 4 MiB holds some 400 ms of such a flood.
+pub const RECEIVE_BUFFER_BYTES: usize = 4 << 20;
+
+/// Asks for [`RECEIVE_BUFFER_BYTES`]; the kernel caps the request at `net.core.rmem_max`, and a
+/// smaller buffer is only a warning (the node still works, it loses frames sooner in a stall).
+fn reserve_receive_buffer(socket: &CanFdSocket, ifname: &str) {
+    let raw = socket.as_raw_socket();
+    let _ = raw.set_recv_buffer_size(RECEIVE_BUFFER_BYTES);
+    // Linux reports twice the size it was asked for, the bookkeeping included.
+    let granted = raw.recv_buffer_size().unwrap_or(0) / 2;
+    if granted < RECEIVE_BUFFER_BYTES {
+        tracing::warn!(
+            ifname,
+            granted,
+            wanted = RECEIVE_BUFFER_BYTES,
+            "small socket receive buffer: a stall under heavy traffic will drop frames; \
+             raise the cap with `sudo sysctl -w net.core.rmem_max={}`",
+            RECEIVE_BUFFER_BYTES
+        );
     }
 }
 
