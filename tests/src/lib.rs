@@ -199,6 +199,12 @@ pub fn firmware(bus: &Vcan) -> Process {
 
 /// Starts `sim-host run` on `bus` (an interface, or `inproc`) writing to `out`, without plots
 /// or progress bar, with `args` added.
+///
+/// Unless `args` set it, a lockstep cycle waits up to 1 s for the firmware's command instead of
+/// the default 100 ms: the VM's emulated CPUs are shared by the simulator, the firmware and
+/// candump, and a process there can be descheduled for longer than 100 ms. Waiting costs a
+/// lockstep run nothing, while a cycle stepped without the command is a real divergence that
+/// the tests count.
 pub fn start_sim(bus: &str, out: &Path, args: &[&str]) -> Process {
     let out_text = out.to_string_lossy().into_owned();
     let mut all = vec![
@@ -210,6 +216,9 @@ pub fn start_sim(bus: &str, out: &Path, args: &[&str]) -> Process {
         "--out",
         &out_text,
     ];
+    if !args.contains(&"--reply-timeout-ms") {
+        all.extend_from_slice(&["--reply-timeout-ms", "1000"]);
+    }
     all.extend_from_slice(args);
     Process::start("sim-host", &all)
 }
