@@ -154,9 +154,10 @@ fn timer(
     let period = Duration::from_nanos(1_000_000_000 / u64::from(rate.hz()));
     let start = Instant::now();
     let mut tick = Tick(0);
-    // The wall-clock period this tick runs in: tick `n` is due at `start + slot * period`.
+    // The period the next tick is due in; period `slot` begins at `start + slot * period`.
     let mut slot: u64 = 0;
     while !done(&config, stats, stop) {
+        slot = current_slot(slot, start.elapsed(), period, &mut stats.overruns);
         while let Some(frame) = bus.recv(Duration::ZERO)? {
             stats.frames_in += 1;
             let _ = node.on_frame(tick, frame.id(), frame.data());
@@ -169,7 +170,7 @@ fn timer(
         stats.ticks += 1;
         tick = tick.plus(1);
         bus.end_cycle()?;
-        slot = next_slot(slot, start.elapsed(), period, &mut stats.overruns);
+        slot += 1;
         let deadline = start + period * u32::try_from(slot).unwrap_or(u32::MAX);
         // Wait for the next tick, taking frames as they come so that they are timely.
         while let Some(left) = deadline.checked_duration_since(Instant::now()) {
@@ -185,19 +186,19 @@ fn timer(
     Ok(())
 }
 
-/// The period the next tick runs in, after one ran in `slot` and `elapsed` has passed since
-/// the start. As the MCU's SysTick loop does, a runner that fell more than a period behind
-/// runs one tick at once and loses the ones in between (counted in `lost`) rather than
-/// bunching them up: the core measures every timeout in ticks, and a burst of ticks with no
-/// frames between them would age the feedback read just before it by the length of the stall.
-fn next_slot(slot: u64, elapsed: Duration, period: Duration, lost: &mut u64) -> u64 {
-    let next = slot + 1;
+/// The period a tick due in `slot` runs in, when it starts `elapsed` after the start. As the
+/// MCU's SysTick loop does, a runner that woke in a later period runs the tick in that one and
+/// loses the ticks of the periods it slept through (counted in `lost`) rather than bunching
+/// them up: the core measures every timeout in ticks, and a burst of ticks with no frames
+/// between them would age the feedback read just before it by the length of the stall. So
+/// at most one tick runs per period.
+fn current_slot(slot: u64, elapsed: Duration, period: Duration, lost: &mut u64) -> u64 {
     let now = u64::try_from(elapsed.as_nanos() / period.as_nanos().max(1)).unwrap_or(u64::MAX);
-    if now > next {
-        *lost += now - next;
+    if now > slot {
+        *lost += now - slot;
         now
     } else {
-        next
+        slot
     }
 }
 
