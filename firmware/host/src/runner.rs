@@ -53,8 +53,8 @@ pub struct RunnerStats {
     /// Frames the firmware rejected, by cause, in [`RejectCause::ALL`] order (unknown id, wrong
     /// length, CRC, out of range, repeated, wrong sequence, rate limited).
     pub rejected: [u64; RejectCause::ALL.len()],
-    /// Timer mode: ticks lost because the runner fell more than a period behind (the tick
-    /// counter then runs slow, as on the MCU, instead of catching up in a burst).
+    /// Timer mode: ticks lost because the runner woke in a later period than the one they were
+    /// due in (the tick counter then runs slow, as on the MCU, instead of catching up in a burst).
     pub overruns: u64,
 }
 
