@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::Ticks;
+use common::{command, imu, leg_feedback, wheels_at_rest, Ticks};
 
 use firmware::controller::Output;
 use firmware::fsm::{LegMotion, State, WheelMotion};
@@ -26,35 +26,6 @@ struct Bench {
     imu_alive: bool,
     teleop_alive: bool,
     pitch_rad: f32,
-}
-
-fn leg_feedback(positions: &[f32]) -> LegFeedback {
-    let mut position = [Angle::saturating_from_si(0.0); 4];
-    for (slot, value) in position.iter_mut().zip(positions) {
-        *slot = Angle::saturating_from_si(*value);
-    }
-    LegFeedback {
-        position,
-        velocity: [JointVelocity::saturating_from_si(0.0); 4],
-        effort: [Torque::saturating_from_si(0.0); 4],
-    }
-}
-
-fn imu(pitch_rad: f32) -> Imu {
-    let half = 0.5 * pitch_rad;
-    Imu {
-        orientation: [half.cos(), 0.0, half.sin(), 0.0].map(QuatComponent::saturating_from_si),
-        angular_rate: [AngularRate::saturating_from_si(0.0); 3],
-        acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
-    }
-}
-
-fn command(mode: TeleopMode) -> AnyMessage {
-    AnyMessage::TeleopCommand(TeleopCommand {
-        mode,
-        body_height: BodyHeight::saturating_from_si(0.0),
-        speed_scale: SpeedScale::from_raw(100).unwrap(),
-    })
 }
 
 fn estop(action: EStopAction) -> AnyMessage {
@@ -90,14 +61,7 @@ impl Bench {
                 self.controller
                     .on_message(now, &AnyMessage::LegFeedback(*leg, leg_feedback(chunk)));
             }
-            self.controller.on_message(
-                now,
-                &AnyMessage::WheelFeedback(WheelFeedback {
-                    position: [WheelAngle::saturating_from_si(0.0); 2],
-                    velocity: [WheelVelocity::saturating_from_si(0.0); 2],
-                    effort: [Torque::saturating_from_si(0.0); 2],
-                }),
-            );
+            self.controller.on_message(now, &wheels_at_rest());
         }
         if self.imu_alive {
             self.controller

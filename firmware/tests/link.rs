@@ -8,18 +8,14 @@
 
 mod common;
 
-use common::Ticks;
+use common::{command, Ticks};
 
 use std::collections::HashMap;
 
 use firmware::controller::Output;
 use firmware::fsm::{Direction, LegMotion, State, WheelMotion};
 use firmware::{Config, Node, Tick};
-use protocol::{
-    Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, ControllerMode, FaultFlags, Imu,
-    JointVelocity, Leg, LegFeedback, QuatComponent, RejectCause, SpeedScale, TeleopCommand,
-    TeleopHeartbeat, TeleopMode, Torque, WheelAngle, WheelFeedback, WheelVelocity,
-};
+use protocol::{AnyMessage, ControllerMode, FaultFlags, RejectCause, TeleopHeartbeat, TeleopMode};
 
 const CONFIG: Config = Config::ROBOT;
 const TROT_F: State = State::Legs(LegMotion::Trot(Direction::Forward));
@@ -87,31 +83,9 @@ impl LossyBench {
     }
 
     fn tick(&mut self) -> Output {
-        let joints_rad = self.joints_rad;
-        for (leg, chunk) in Leg::ALL.iter().zip(joints_rad.chunks_exact(4)) {
-            let mut position = [Angle::saturating_from_si(0.0); 4];
-            for (slot, value) in position.iter_mut().zip(chunk) {
-                *slot = Angle::saturating_from_si(*value);
-            }
-            self.send(AnyMessage::LegFeedback(
-                *leg,
-                LegFeedback {
-                    position,
-                    velocity: [JointVelocity::saturating_from_si(0.0); 4],
-                    effort: [Torque::saturating_from_si(0.0); 4],
-                },
-            ));
+        for message in common::plant_feedback(&self.joints_rad) {
+            self.send(message);
         }
-        self.send(AnyMessage::WheelFeedback(WheelFeedback {
-            position: [WheelAngle::saturating_from_si(0.0); 2],
-            velocity: [WheelVelocity::saturating_from_si(0.0); 2],
-            effort: [Torque::saturating_from_si(0.0); 2],
-        }));
-        self.send(AnyMessage::Imu(Imu {
-            orientation: [1.0, 0.0, 0.0, 0.0].map(QuatComponent::saturating_from_si),
-            angular_rate: [AngularRate::saturating_from_si(0.0); 3],
-            acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
-        }));
         if self.now % 5 == 0 {
             self.send(command(self.mode));
             self.send(AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
@@ -151,14 +125,6 @@ impl Ticks for LossyBench {
     fn tick(&mut self) -> Output {
         LossyBench::tick(self)
     }
-}
-
-fn command(mode: TeleopMode) -> AnyMessage {
-    AnyMessage::TeleopCommand(TeleopCommand {
-        mode,
-        body_height: BodyHeight::saturating_from_si(0.0),
-        speed_scale: SpeedScale::from_raw(100).unwrap(),
-    })
 }
 
 fn ticks_from_s(s: u32) -> u32 {

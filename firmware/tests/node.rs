@@ -1,23 +1,17 @@
 //! The controller as a CAN node: what goes out each tick, and what happens to bad frames.
 
+mod common;
+
 use firmware::fsm::{Direction, LegMotion, State, WheelMotion};
 use firmware::node::TELEOP_COMMANDS_PER_TICK;
 use firmware::{Config, Node, Tick};
 use protocol::{
-    decode_frame, Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, DecodeError,
-    DriveEnable, EStop, EStopAction, Imu, JointVelocity, Leg, LegFeedback, MessageId, NodeId,
-    QuatComponent, RejectCause, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, Torque,
-    WheelAngle, WheelFeedback, WheelVelocity,
+    decode_frame, AnyMessage, DecodeError, DriveEnable, EStop, EStopAction, MessageId, NodeId,
+    RejectCause, TeleopHeartbeat, TeleopMode,
 };
 
 fn teleop_frame(mode: TeleopMode, counter: u16) -> protocol::Frame {
-    AnyMessage::TeleopCommand(TeleopCommand {
-        mode,
-        body_height: BodyHeight::saturating_from_si(0.0),
-        speed_scale: SpeedScale::from_raw(100).unwrap(),
-    })
-    .encode(counter)
-    .unwrap()
+    common::command(mode).encode(counter).unwrap()
 }
 
 #[test]
@@ -109,32 +103,9 @@ fn the_readmes_cansend_estop_latches_and_clears() {
     assert_eq!(node.controller().state(), State::EStop);
 }
 
-/// The feedback of one tick (four legs, wheels, IMU) with rolling counter `counter`.
+/// The feedback of one tick (four legs at zero, wheels, IMU) with rolling counter `counter`.
 fn feedback_frames(counter: u16) -> Vec<protocol::Frame> {
-    let mut messages: Vec<AnyMessage> = Leg::ALL
-        .iter()
-        .map(|leg| {
-            AnyMessage::LegFeedback(
-                *leg,
-                LegFeedback {
-                    position: [Angle::saturating_from_si(0.0); 4],
-                    velocity: [JointVelocity::saturating_from_si(0.0); 4],
-                    effort: [Torque::saturating_from_si(0.0); 4],
-                },
-            )
-        })
-        .collect();
-    messages.push(AnyMessage::WheelFeedback(WheelFeedback {
-        position: [WheelAngle::saturating_from_si(0.0); 2],
-        velocity: [WheelVelocity::saturating_from_si(0.0); 2],
-        effort: [Torque::saturating_from_si(0.0); 2],
-    }));
-    messages.push(AnyMessage::Imu(Imu {
-        orientation: [1.0, 0.0, 0.0, 0.0].map(QuatComponent::saturating_from_si),
-        angular_rate: [AngularRate::saturating_from_si(0.0); 3],
-        acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
-    }));
-    messages
+    common::plant_feedback(&[0.0; 16])
         .iter()
         .map(|m| m.encode(counter).unwrap())
         .collect()

@@ -1,6 +1,13 @@
-//! Shared by the firmware's closed-loop benches: the pose they start in.
+//! Shared by the firmware's closed-loop benches: the pose they start in, and the messages an
+//! ideal plant and operator send. Each test binary uses part of it.
+#![allow(dead_code)]
 
 use firmware::config::Config;
+use protocol::{
+    Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, Imu, JointVelocity, Leg, LegFeedback,
+    QuatComponent, SpeedScale, TeleopCommand, TeleopMode, Torque, WheelAngle, WheelFeedback,
+    WheelVelocity,
+};
 
 /// Every leg at the nominal stance of `config`, wire order, rad: the robot standing.
 pub fn standing_joints_rad(config: &Config) -> [f32; 16] {
@@ -33,4 +40,58 @@ pub trait Ticks {
         }
         last
     }
+}
+
+/// One leg's feedback: joints at `positions_rad` (wire order), at rest, no effort.
+pub fn leg_feedback(positions_rad: &[f32]) -> LegFeedback {
+    let mut position = [Angle::saturating_from_si(0.0); 4];
+    for (slot, value) in position.iter_mut().zip(positions_rad) {
+        *slot = Angle::saturating_from_si(*value);
+    }
+    LegFeedback {
+        position,
+        velocity: [JointVelocity::saturating_from_si(0.0); 4],
+        effort: [Torque::saturating_from_si(0.0); 4],
+    }
+}
+
+/// The wheel drive's feedback with both wheels at rest.
+pub fn wheels_at_rest() -> AnyMessage {
+    AnyMessage::WheelFeedback(WheelFeedback {
+        position: [WheelAngle::saturating_from_si(0.0); 2],
+        velocity: [WheelVelocity::saturating_from_si(0.0); 2],
+        effort: [Torque::saturating_from_si(0.0); 2],
+    })
+}
+
+/// An IMU sample of a torso pitched by `pitch_rad`, still, in 1 g.
+pub fn imu(pitch_rad: f32) -> Imu {
+    let half = 0.5 * pitch_rad;
+    Imu {
+        orientation: [half.cos(), 0.0, half.sin(), 0.0].map(QuatComponent::saturating_from_si),
+        angular_rate: [AngularRate::saturating_from_si(0.0); 3],
+        acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
+    }
+}
+
+/// One tick of an ideal plant's feedback: the four legs at `joints_rad` (wire order), the
+/// wheels at rest, the torso level.
+pub fn plant_feedback(joints_rad: &[f32; 16]) -> Vec<AnyMessage> {
+    let mut messages: Vec<AnyMessage> = Leg::ALL
+        .iter()
+        .zip(joints_rad.chunks_exact(4))
+        .map(|(leg, chunk)| AnyMessage::LegFeedback(*leg, leg_feedback(chunk)))
+        .collect();
+    messages.push(wheels_at_rest());
+    messages.push(AnyMessage::Imu(imu(0.0)));
+    messages
+}
+
+/// The operator asking for `mode` at nominal height and full speed.
+pub fn command(mode: TeleopMode) -> AnyMessage {
+    AnyMessage::TeleopCommand(TeleopCommand {
+        mode,
+        body_height: BodyHeight::saturating_from_si(0.0),
+        speed_scale: SpeedScale::from_raw(100).unwrap(),
+    })
 }
