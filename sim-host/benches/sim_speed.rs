@@ -7,8 +7,8 @@ use std::path::Path;
 use std::time::Duration;
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use firmware_host::bus::Bus;
-use firmware_host::inproc_bus::InprocBus;
+use host_can::bus::Bus;
+use host_can::inproc_bus::InprocBus;
 use protocol::TeleopMode;
 use sim_host::imu::ImuNoise;
 use sim_host::inproc_controller::InprocController;

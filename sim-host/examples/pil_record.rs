@@ -19,8 +19,8 @@ use std::time::Duration;
 
 use firmware::node::Node;
 use firmware::time::Tick;
-use firmware_host::bus::Bus;
-use firmware_host::inproc_bus::InprocBus;
+use host_can::bus::Bus;
+use host_can::inproc_bus::InprocBus;
 use protocol::TeleopMode;
 use sim_host::imu::ImuNoise;
 use sim_host::lockstep::{self, LockstepOptions};

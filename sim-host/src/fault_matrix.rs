@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use firmware::fsm::{LegMotion, State, WheelMotion};
-use firmware_host::fault_plan::{feedback_nodes, FaultPlan, Faults};
+use host_can::fault_plan::{feedback_nodes, FaultPlan, Faults};
 use protocol::{
     AnyMessage, EStop, EStopAction, FaultFlags, MessageId, NodeId, RejectCause, TeleopMode,
 };

@@ -8,10 +8,10 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use firmware::fsm::State;
-use firmware_host::bus::Bus;
-use firmware_host::fault_plan::Faults;
-use firmware_host::faulty_bus::{FaultStats, FaultyBus};
-use firmware_host::inproc_bus::{InprocBus, InprocEndpoint};
+use host_can::bus::Bus;
+use host_can::fault_plan::Faults;
+use host_can::faulty_bus::{FaultStats, FaultyBus};
+use host_can::inproc_bus::{InprocBus, InprocEndpoint};
 use protocol::{FaultFlags, Frame, RejectCause, RejectCounters};
 use teleop_core::scripted::{PlanStep, ScriptedTeleop};
 

@@ -11,8 +11,8 @@ use firmware::node::Node;
 use firmware::time::Tick;
 use protocol::{decode_frame, AnyMessage, MessageId};
 
-use firmware_host::bus::{Bus, BusError};
-use firmware_host::inproc_bus::InprocEndpoint;
+use host_can::bus::{Bus, BusError};
+use host_can::inproc_bus::InprocEndpoint;
 use std::time::Duration;
 
 /// The firmware node and its bus endpoint.

@@ -3,12 +3,11 @@
 //! E2E checks and a command timeout.
 //!
 //! - [`physics`]: the model and its state (ground truth);
-//! - the buses come from `firmware_host` (one abstraction, in-process and SocketCAN);
+//! - the buses come from `host_can` (one abstraction, in-process and SocketCAN);
 //! - [`leg_drive`], [`wheel_drive`], [`imu`], [`hardware`]: the emulated nodes;
 //! - [`lockstep`], [`realtime`]: the two clocks;
 //! - [`telemetry`], [`telemetry_csv`], [`candump`], [`plots`]: what a user looks at.
 
-pub mod candump;
 pub mod drive_core;
 pub mod error_chain;
 pub mod fault_matrix;

@@ -12,7 +12,7 @@ use protocol::MessageId;
 use crate::recorder::Recorder;
 use crate::run_stats::{RunError, RunStats};
 use crate::simulator::Simulator;
-use firmware_host::bus::Bus;
+use host_can::bus::Bus;
 
 /// Lockstep settings.
 #[derive(Debug, Clone, Copy, PartialEq)]

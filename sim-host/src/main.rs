@@ -9,7 +9,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use firmware_host::fault_plan::Faults;
+use host_can::fault_plan::Faults;
 use protocol::TeleopMode;
 use sim_host::imu::ImuNoise;
 use sim_host::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
@@ -173,7 +173,7 @@ fn parse_step(text: &str) -> Result<PlanStep, String> {
 }
 
 fn main() -> ExitCode {
-    firmware_host::logging::init("info");
+    host_can::logging::init("info");
     let cli = Cli::parse();
     match cli.command {
         Command::Faults { model } => faults(&model),

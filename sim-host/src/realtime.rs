@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 use crate::recorder::Recorder;
 use crate::run_stats::{RunError, RunStats};
 use crate::simulator::Simulator;
-use firmware_host::bus::Bus;
+use host_can::bus::Bus;
 
 /// Real-time settings.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 
 use protocol::Frame;
 
-use crate::candump::CandumpWriter;
 use crate::output_error::OutputError;
-use crate::telemetry::{LoggedFrame, TelemetryRow};
+use crate::telemetry::TelemetryRow;
+use host_can::candump::{CandumpWriter, LoggedFrame};
 
 /// The recorder of one run.
 #[derive(Debug, Default)]

@@ -3,7 +3,7 @@
 use std::time::Duration;
 
 use crate::output_error::OutputError;
-use firmware_host::bus::BusError;
+use host_can::bus::BusError;
 
 /// Counters of one run.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

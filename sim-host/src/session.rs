@@ -23,11 +23,11 @@ use crate::recorder::Recorder;
 use crate::run_stats::{RunError, RunStats};
 use crate::simulator::{Simulator, StartPose};
 use crate::telemetry::TelemetryRow;
-use firmware_host::bus::{Bus, BusError};
-use firmware_host::fault_plan::Faults;
-use firmware_host::faulty_bus::{FaultStats, FaultyBus};
-use firmware_host::inproc_bus::InprocBus;
-use firmware_host::socketcan_bus::SocketCanBus;
+use host_can::bus::{Bus, BusError};
+use host_can::fault_plan::Faults;
+use host_can::faulty_bus::{FaultStats, FaultyBus};
+use host_can::inproc_bus::InprocBus;
+use host_can::socketcan_bus::SocketCanBus;
 use teleop_core::scripted::{PlanStep, ScriptedTeleop};
 
 /// Which bus the simulator joins.
@@ -96,7 +96,7 @@ pub struct SessionConfig {
     /// Someone outside the session on the in-process bus (the interactive teleop), or `None`.
     pub attach: Option<Attach>,
     /// Faults on the simulator's bus connection: `tx` breaks the feedback it sends, `rx` the
-    /// commands it receives (see [`firmware_host::fault_plan`]).
+    /// commands it receives (see [`host_can::fault_plan`]).
     pub faults: Faults,
 }
 

@@ -1,6 +1,6 @@
 //! The simulated robot: MuJoCo physics plus the emulated CAN nodes, advanced one control cycle
 //! at a time. Bus- and clock-agnostic: [`crate::lockstep`] and [`crate::realtime`] move frames
-//! between it and a [`firmware_host::bus::Bus`].
+//! between it and a [`host_can::bus::Bus`].
 
 use std::path::Path;
 

@@ -26,12 +26,3 @@ pub struct TelemetryRow {
     /// The controller's mode from its last status frame, `None` before the first.
     pub mode: Option<ControllerMode>,
 }
-
-/// A frame seen on the bus, for the candump log.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LoggedFrame {
-    /// When it was seen: simulation time in lockstep, wall time since start in real time, s.
-    pub time_s: f64,
-    /// The frame.
-    pub frame: protocol::Frame,
-}

@@ -7,8 +7,8 @@ use std::path::Path;
 use std::rc::Rc;
 use std::time::Duration;
 
-use firmware_host::bus::Bus;
-use firmware_host::inproc_bus::{InprocBus, InprocEndpoint};
+use host_can::bus::Bus;
+use host_can::inproc_bus::{InprocBus, InprocEndpoint};
 use protocol::{
     Angle, AnyMessage, DriveEnable, DriveFlags, DriveStatus, E2eCounter, EStop, EStopAction, Frame,
     Leg, LegFeedback, LegTargets, NodeId, Receiver, Torque, WheelCommand, WheelFeedback,

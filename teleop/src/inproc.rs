@@ -8,7 +8,7 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use firmware_host::inproc_bus::InprocEndpoint;
+use host_can::inproc_bus::InprocEndpoint;
 use sim_host::imu::ImuNoise;
 use sim_host::session::{
     self, Attach, BusChoice, Clock, SessionConfig, SessionError, SessionReport,

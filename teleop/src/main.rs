@@ -7,8 +7,8 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use clap::{Parser, Subcommand};
-use firmware_host::bus::Bus;
-use firmware_host::socketcan_bus::SocketCanBus;
+use host_can::bus::Bus;
+use host_can::socketcan_bus::SocketCanBus;
 use teleop::script::{self, ScriptReport};
 use teleop_core::keys::{action, Action, Key};
 use teleop_core::scenario::{mode_name, Scenario};
@@ -98,7 +98,7 @@ impl Failure {
 }
 
 fn main() -> ExitCode {
-    firmware_host::logging::init("warn");
+    host_can::logging::init("warn");
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,

@@ -7,7 +7,7 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use firmware_host::bus::{Bus, BusError};
+use host_can::bus::{Bus, BusError};
 use protocol::{ControllerMode, EncodeError, Frame};
 use teleop_core::bus_status::BusStatus;
 use teleop_core::keys::Action;

@@ -6,8 +6,8 @@
 
 use std::time::{Duration, Instant};
 
-use firmware_host::bus::Bus;
-use firmware_host::inproc_bus::{InprocBus, InprocEndpoint};
+use host_can::bus::Bus;
+use host_can::inproc_bus::{InprocBus, InprocEndpoint};
 use protocol::{decode_frame, AnyMessage, ControllerMode, DriveEnable, FaultFlags, Frame};
 use sim_host::imu::ImuNoise;
 use sim_host::inproc_controller::InprocController;

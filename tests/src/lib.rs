@@ -13,7 +13,7 @@ use std::process::{Child, Command, Stdio};
 use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::{Duration, Instant};
 
-use firmware_host::socketcan_bus::RECEIVE_BUFFER_BYTES;
+use host_can::socketcan_bus::RECEIVE_BUFFER_BYTES;
 
 /// The workspace root.
 pub fn workspace() -> PathBuf {
@@ -248,19 +248,10 @@ pub fn scenario(name: &str) -> String {
         .into_owned()
 }
 
-/// A frame in `cansend`'s notation: `ID##<flags><hex>` (CAN FD, bit-rate switch flag set).
-pub fn cansend_text(frame: &protocol::Frame) -> String {
-    let mut text = format!("{:03X}##1", frame.id());
-    for byte in frame.data() {
-        text.push_str(&format!("{byte:02X}"));
-    }
-    text
-}
-
 /// Sends `frame` with can-utils' `cansend`.
 pub fn cansend(bus: &Vcan, frame: &protocol::Frame) {
     let status = Command::new(program("cansend"))
-        .args([bus.name(), &cansend_text(frame)])
+        .args([bus.name(), &host_can::candump::cansend_text(frame)])
         .status()
         .unwrap_or_else(|e| panic!("cannot run cansend (can-utils): {e}"));
     assert!(status.success(), "cansend failed: {status}");
@@ -273,7 +264,7 @@ pub fn candump(bus: &Vcan, path: &Path) -> Process {
 
 /// Starts `candump -L <bus><filter>` writing to `path`; `filter` in candump's notation, e.g.
 /// `,200~7FF` for everything but id 0x200. Its socket buffer is as large as the nodes' (see
-/// `firmware_host::socketcan_bus::RECEIVE_BUFFER_BYTES`): the log is the tests' evidence, and a
+/// `host_can::socketcan_bus::RECEIVE_BUFFER_BYTES`): the log is the tests' evidence, and a
 /// candump descheduled on a busy VM must not drop what the nodes received.
 pub fn candump_filtered(bus: &Vcan, path: &Path, filter: &str) -> Process {
     let file = std::fs::File::create(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
@@ -300,32 +291,10 @@ impl Process {
 /// frame of this project's form panics with the line.
 pub fn read_candump(path: &Path) -> Vec<(f64, protocol::Frame)> {
     let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-    // A log still being written may end in half a line: only complete lines count.
-    let complete = text.rfind('\n').map_or("", |end| &text[..end]);
-    complete
-        .lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|line| {
-            let mut parts = line.split_whitespace();
-            let time = parts
-                .next()
-                .and_then(|t| t.trim_matches(|c| c == '(' || c == ')').parse::<f64>().ok())
-                .unwrap_or_else(|| panic!("no time in `{line}`"));
-            let frame = parts
-                .nth(1)
-                .unwrap_or_else(|| panic!("no frame in `{line}`"));
-            let (id, rest) = frame
-                .split_once("##")
-                .unwrap_or_else(|| panic!("not a CAN FD frame: `{line}`"));
-            let id = u16::from_str_radix(id, 16).unwrap_or_else(|_| panic!("bad id in `{line}`"));
-            let hex = rest.get(1..).unwrap_or("");
-            let data: Vec<u8> = (0..hex.len() / 2)
-                .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).unwrap_or(0))
-                .collect();
-            let frame = protocol::Frame::new(id, &data)
-                .unwrap_or_else(|| panic!("not a valid CAN FD frame: `{line}`"));
-            (time, frame)
-        })
+    host_can::candump::read_log(&text)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .into_iter()
+        .map(|logged| (logged.time_s, logged.frame))
         .collect()
 }
 

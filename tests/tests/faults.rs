@@ -6,14 +6,14 @@
 use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
-use firmware_host::bus::Bus;
-use firmware_host::fault_plan::Faults;
-use firmware_host::faulty_bus::FaultyBus;
-use firmware_host::socketcan_bus::SocketCanBus;
 use hil_tests::{
     candump, candump_filtered, firmware, out_dir, read_candump, read_telemetry, scenario, simulate,
     start_sim, wait_for_log, Process, Vcan,
 };
+use host_can::bus::Bus;
+use host_can::fault_plan::Faults;
+use host_can::faulty_bus::FaultyBus;
+use host_can::socketcan_bus::SocketCanBus;
 use protocol::{
     decode_frame, AnyMessage, BodyHeight, ControllerMode, FaultFlags, Frame, MessageId, Millis,
     NodeId, Receiver, RejectCause, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode,

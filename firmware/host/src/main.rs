@@ -7,10 +7,10 @@ use std::sync::Arc;
 use std::time::Duration;
 
 use clap::{Parser, ValueEnum};
-use firmware_host::fault_plan::Faults;
-use firmware_host::faulty_bus::FaultyBus;
 use firmware_host::runner::{self, Clock, RunnerConfig};
-use firmware_host::socketcan_bus::SocketCanBus;
+use host_can::fault_plan::Faults;
+use host_can::faulty_bus::FaultyBus;
+use host_can::socketcan_bus::SocketCanBus;
 
 /// The hybrid robot's firmware as a host process on a CAN interface.
 ///
@@ -55,7 +55,7 @@ enum ClockArg {
 }
 
 fn main() -> ExitCode {
-    firmware_host::logging::init("info");
+    host_can::logging::init("info");
     let cli = Cli::parse();
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);

@@ -17,7 +17,7 @@ use firmware::node::Node;
 use firmware::time::{Tick, TickRate};
 use protocol::{decode_frame, AnyMessage, MessageId, RejectCause};
 
-use crate::bus::{Bus, BusError};
+use host_can::{Bus, BusError};
 
 /// How the runner keeps time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

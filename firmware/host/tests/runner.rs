@@ -5,9 +5,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-use firmware_host::bus::{Bus, BusError};
-use firmware_host::inproc_bus::InprocBus;
 use firmware_host::runner::{self, Clock, RunnerConfig};
+use host_can::bus::{Bus, BusError};
+use host_can::inproc_bus::InprocBus;
 use protocol::{AnyMessage, DriveEnable, E2eCounter, MessageId, Receiver, Sync, Tick};
 
 fn sync(tick: u32, counter: &mut E2eCounter) -> protocol::Frame {

@@ -3,10 +3,10 @@
 
 use std::time::Duration;
 
-use firmware_host::bus::Bus;
-use firmware_host::fault_plan::Faults;
-use firmware_host::faulty_bus::FaultyBus;
-use firmware_host::inproc_bus::{InprocBus, InprocEndpoint};
+use host_can::bus::Bus;
+use host_can::fault_plan::Faults;
+use host_can::faulty_bus::FaultyBus;
+use host_can::inproc_bus::{InprocBus, InprocEndpoint};
 use protocol::{
     AnyMessage, BodyHeight, Frame, Receiver, RejectCause, SpeedScale, Sync, TeleopCommand,
     TeleopMode, Tick,

@@ -14,11 +14,22 @@ use std::io::{self, Write};
 
 use protocol::{Frame, MAX_STANDARD_ID};
 
-use crate::telemetry::LoggedFrame;
+/// A frame seen on the bus, with when: one line of the log.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LoggedFrame {
+    /// When it was seen: simulation time in lockstep, wall time since start in real time, s.
+    pub time_s: f64,
+    /// The frame.
+    pub frame: Frame,
+}
 
 /// The flags digit written after `##`: `CANFD_FDF` (0x4), without `CANFD_BRS` (0x1) or
 /// `CANFD_ESI` (0x2), as candump logs a CAN FD frame sent without bit-rate switch.
 pub const FD_FLAGS: u8 = 0x4;
+
+/// The flags digit [`cansend_text`] writes: `CANFD_BRS` (0x1), a CAN FD frame sent with
+/// bit-rate switch, as the robot's nodes send.
+pub const CANSEND_FLAGS: u8 = 0x1;
 
 /// Longest interface name Linux allows (`IFNAMSIZ` − 1), bytes.
 const MAX_INTERFACE_LEN: usize = 15;
@@ -85,17 +96,65 @@ fn format_line(line: &mut String, time_s: f64, interface: &str, frame: &Frame) -
         )
     })?;
     let (seconds, fraction) = (micros / 1_000_000, micros % 1_000_000);
-    let id = frame.id();
-    write!(
-        line,
-        "({seconds:010}.{fraction:06}) {interface} {id:03X}##{FD_FLAGS:X}"
-    )
-    .map_err(io::Error::other)?;
-    for byte in frame.data() {
-        write!(line, "{byte:02X}").map_err(io::Error::other)?;
-    }
+    write!(line, "({seconds:010}.{fraction:06}) {interface} ").map_err(io::Error::other)?;
+    push_frame(line, frame, FD_FLAGS);
     line.push('\n');
     Ok(())
+}
+
+/// Appends `frame` in can-utils' frame notation, `ID##<flags><DATA>`.
+fn push_frame(line: &mut String, frame: &Frame, flags: u8) {
+    const HEX: &[u8; 16] = b"0123456789ABCDEF";
+    let id = frame.id();
+    for shift in [8, 4, 0] {
+        line.push(char::from(HEX[usize::from(id >> shift & 0xF)]));
+    }
+    line.push_str("##");
+    line.push(char::from(HEX[usize::from(flags & 0xF)]));
+    for byte in frame.data() {
+        line.push(char::from(HEX[usize::from(byte >> 4)]));
+        line.push(char::from(HEX[usize::from(byte & 0xF)]));
+    }
+}
+
+/// `frame` as `cansend` takes it: `ID##<flags><DATA>` with the bit-rate-switch flag
+/// ([`CANSEND_FLAGS`]), as the robot's nodes send their frames.
+pub fn cansend_text(frame: &Frame) -> String {
+    let mut text = String::with_capacity(6 + 2 * frame.data().len());
+    push_frame(&mut text, frame, CANSEND_FLAGS);
+    text
+}
+
+/// Why a log could not be read: the line (1-based) and its cause.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("line {line}: {cause}")]
+pub struct CandumpLogError {
+    /// The line number, from 1.
+    pub line: usize,
+    /// What is wrong with it.
+    pub cause: CandumpParseError,
+}
+
+/// Every frame of a candump log's text, in order. A log still being written may end in half a
+/// line: only complete lines (ending in `\n`) count, and blank lines are skipped. The first
+/// line that is not a frame of this bus is the error.
+pub fn read_log(text: &str) -> Result<Vec<LoggedFrame>, CandumpLogError> {
+    let complete = text
+        .rfind('\n')
+        .map_or("", |end| text.get(..end).unwrap_or(""));
+    complete
+        .lines()
+        .enumerate()
+        .filter(|(_, line)| !line.trim().is_empty())
+        .map(|(index, line)| {
+            parse_line(line)
+                .map(|(time_s, _, frame)| LoggedFrame { time_s, frame })
+                .map_err(|cause| CandumpLogError {
+                    line: index + 1,
+                    cause,
+                })
+        })
+        .collect()
 }
 
 /// `time_s` in whole microseconds, or `None` if negative or not finite.
@@ -372,6 +431,25 @@ mod tests {
             parse_line(&too_long),
             Err(CandumpParseError::BadLength { len: 65 })
         );
+    }
+
+    #[test]
+    fn cansend_text_uses_the_bit_rate_switch_flag() {
+        assert_eq!(cansend_text(&frame(0x00A, &[0x01, 0xFE])), "00A##101FE");
+        assert_eq!(cansend_text(&frame(0x7FF, &[])), "7FF##1");
+    }
+
+    #[test]
+    fn a_log_reads_complete_lines_and_names_the_bad_one() {
+        let text = "(0.004000) vcan0 101##401\n\n(0.008000) vcan0 102##4\n(0.0120";
+        let frames = read_log(text).unwrap();
+        assert_eq!(frames.len(), 2);
+        assert_eq!(frames[1].frame, frame(0x102, &[]));
+        assert_eq!(frames[1].time_s, 0.008);
+        let error = read_log("(0.004000) vcan0 101##401\n(0.008) vcan0 102#11\n").unwrap_err();
+        assert_eq!(error.line, 2);
+        assert!(matches!(error.cause, CandumpParseError::NotCanFd { .. }));
+        assert!(error.to_string().starts_with("line 2: "));
     }
 
     #[test]
