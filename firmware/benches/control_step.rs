@@ -63,11 +63,11 @@ fn operator(mode: TeleopMode) -> [AnyMessage; 2] {
 /// A controller brought into `mode` by an ideal plant, and the tick it reached.
 fn controller_in(mode: TeleopMode) -> (Controller, u32) {
     let target = match mode {
-        TeleopMode::TrotForward => firmware::fsm::State::Legs(firmware::fsm::LegMotion::Trot(
-            firmware::fsm::Direction::Forward,
-        )),
-        _ => firmware::fsm::State::Wheels(firmware::fsm::WheelMotion::Drive(
-            firmware::fsm::Direction::Forward,
+        TeleopMode::TrotForward => firmware::control::fsm::State::Legs(
+            firmware::control::fsm::LegMotion::Trot(firmware::control::fsm::Direction::Forward),
+        ),
+        _ => firmware::control::fsm::State::Wheels(firmware::control::fsm::WheelMotion::Drive(
+            firmware::control::fsm::Direction::Forward,
         )),
     };
     let mut controller = Controller::new(Config::ROBOT).unwrap();
@@ -157,8 +157,8 @@ fn bench_node(c: &mut Criterion) {
         black_box(node.poll(Tick(tick)));
         tick += 1;
     }
-    let trotting = firmware::fsm::State::Legs(firmware::fsm::LegMotion::Trot(
-        firmware::fsm::Direction::Forward,
+    let trotting = firmware::control::fsm::State::Legs(firmware::control::fsm::LegMotion::Trot(
+        firmware::control::fsm::Direction::Forward,
     ));
     assert_eq!(node.controller().state(), trotting);
     c.bench_function("node/trot", |b| {

@@ -1,14 +1,14 @@
 //! Every tunable of the controller in one value, with the report's numbers as defaults.
 
-use crate::balance::{BalanceConfig, BalanceGains, BalanceModel};
-use crate::gait::TrotParams;
-use crate::kinematics::LegGeometry;
+use crate::legs::gait::TrotParams;
+use crate::legs::kinematics::LegGeometry;
+use crate::legs::posture::Posture;
+use crate::legs::smoothing::Smoother;
+use crate::legs::support::SupportGeometry;
 use crate::limits::JointLimits;
-use crate::posture::Posture;
-use crate::smoothing::Smoother;
-use crate::support::SupportGeometry;
 use crate::time::TickRate;
-use crate::wheel::SpeedLoopGains;
+use crate::wheels::balance::{BalanceConfig, BalanceGains, BalanceModel};
+use crate::wheels::wheel::SpeedLoopGains;
 
 /// Controller configuration.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,7 +55,7 @@ pub struct Config {
     /// 20 ms period before, and the watchdog acts on the next 4 ms tick.
     pub teleop_timeout_ms: u32,
     /// Length of one window of the link monitor, ms: the inbound loss ratio is judged once per
-    /// window (see [`crate::link`]). 1 s holds well over a thousand frames at 250 Hz, so 10 %
+    /// window (see [`crate::node::link`]). 1 s holds well over a thousand frames at 250 Hz, so 10 %
     /// loss stands far above the count's noise at 5 %, and a lossy link is stopped within two
     /// windows of the loss starting.
     pub link_window_ms: u32,

@@ -6,14 +6,14 @@
 //! double-precision floats, integer time, bounded loops; clippy denies `unwrap`, `expect`,
 //! `panic` and unchecked indexing.
 //!
+//! The folders are the layers, from the bus inwards:
+//!
 //! | layer | module | what it does |
 //! |---|---|---|
-//! | CAN node | [`node`], [`can`], [`rate_limit`], [`link`] | frames in (decode, E2E, counted rejects, a per-tick budget for operator commands, the link's loss ratio), frames out on the bus schedule |
-//! | control step | [`controller`] | supervisor → FSM → leg goals + smoothing → wheel law → clamps |
-//! | modes | [`fsm`] | states, events and the transition table |
-//! | legs | [`kinematics`], [`posture`], [`gait`], [`foot_trajectory`], [`sine_gait`], [`phase`], [`smoothing`] | IK/FK, stance and fold, the trot |
-//! | wheels | [`balance`], [`wheel`] | LQR balance on IMU pitch, turn speed loop, torque mixing |
-//! | safety | [`safety`], [`sensors`], [`teleop`] | watchdogs, clamps, operator requests |
+//! | CAN node | [`node`] ([`node::service`], [`node::rate_limit`], [`node::link`]) | frames in (decode, E2E, counted rejects, a per-tick budget for operator commands, the link's loss ratio), frames out on the bus schedule; the one service loop every target runs |
+//! | control | [`control`] ([`control::controller`], [`control::fsm`], [`control::safety`], [`control::sensors`], [`control::teleop`]) | the control step (supervisor → FSM → leg goals + smoothing → wheel law → clamps), modes, watchdogs and clamps, operator requests |
+//! | legs | [`legs`] | IK/FK, stance and fold, the trot |
+//! | wheels | [`wheels`] | LQR balance on IMU pitch, turn speed loop, torque mixing |
 //! | basics | [`config`], [`limits`], [`math`], [`time`], [`attitude`] | parameters, units, maths choices |
 #![no_std]
 #![deny(missing_docs)]
@@ -28,31 +28,16 @@
 pub use protocol;
 
 pub mod attitude;
-pub mod balance;
-pub mod can;
 pub mod config;
-pub mod controller;
-pub mod foot_trajectory;
-pub mod fsm;
-pub mod gait;
-pub mod kinematics;
+pub mod control;
+pub mod legs;
 pub mod limits;
-pub mod link;
 pub mod math;
 pub mod node;
-pub mod phase;
-pub mod posture;
-pub mod rate_limit;
-pub mod safety;
-pub mod sensors;
-pub mod sine_gait;
-pub mod smoothing;
-pub mod support;
-pub mod teleop;
 pub mod time;
-pub mod wheel;
+pub mod wheels;
 
 pub use config::Config;
-pub use controller::{Controller, Output, Status};
+pub use control::controller::{Controller, Output, Status};
 pub use node::Node;
 pub use time::{Tick, TickRate};

@@ -1,5 +1,5 @@
 //! Joint ranges of a leg, from the report's section 5.1 (hip1 ±35°, hip2 ±50°, knee −110…+15°,
-//! ankle ±40°), in the model's joint convention (see [`crate::kinematics`]).
+//! ankle ±40°), in the model's joint convention (see [`crate::legs::kinematics`]).
 
 use crate::math::deg_to_rad;
 
@@ -42,7 +42,7 @@ impl JointRange {
 pub enum Joint {
     /// `hip1_*`: abduction about the forward axis.
     HipAbduction,
-    /// `hip2_*`: hip pitch, the report's q1 (offset by π/2, see [`crate::kinematics`]).
+    /// `hip2_*`: hip pitch, the report's q1 (offset by π/2, see [`crate::legs::kinematics`]).
     HipPitch,
     /// `knee_*`: the report's q2.
     Knee,

@@ -1,9 +1,9 @@
-//! The balance law's design: LQR on the linear wheeled-pendulum model of `firmware::balance`,
+//! The balance law's design: LQR on the linear wheeled-pendulum model of `firmware::wheels::balance`,
 //! solved here on the host with `nalgebra`. Fails when the committed gains are stale (and
 //! prints the new ones), and checks the firmware's own `Balance` on the model.
 
-use firmware::balance::{Balance, BalanceConfig, BalanceGains, BalanceInput, BalanceModel};
 use firmware::config::Config;
+use firmware::wheels::balance::{Balance, BalanceConfig, BalanceGains, BalanceInput, BalanceModel};
 use nalgebra::{Matrix1, Matrix4, Matrix4x1, SMatrix};
 
 const GRAVITY: f64 = 9.81;

@@ -5,8 +5,8 @@ mod common;
 
 use common::{command, imu, leg_feedback, wheels_at_rest, Ticks};
 
-use firmware::controller::Output;
-use firmware::fsm::{LegMotion, State, WheelMotion};
+use firmware::control::controller::Output;
+use firmware::control::fsm::{LegMotion, State, WheelMotion};
 use firmware::{Config, Controller, Tick};
 use proptest::prelude::*;
 use protocol::{
@@ -121,7 +121,9 @@ fn w_folds_the_legs_at_the_fold_rate_then_drives_on_the_wheels() {
     let output = bench.tick();
     assert_eq!(
         bench.state(),
-        State::Folding(WheelMotion::Drive(firmware::fsm::Direction::Forward))
+        State::Folding(WheelMotion::Drive(
+            firmware::control::fsm::Direction::Forward
+        ))
     );
     assert_eq!(output.status.mode, protocol::ControllerMode::Folding);
     // The report's smoothing at rate 6 /s: the first step covers 6 · 0.004 = 2.4 % of the way.
@@ -136,7 +138,9 @@ fn w_folds_the_legs_at_the_fold_rate_then_drives_on_the_wheels() {
     assert!((0.5..1.2).contains(&seconds), "folded in {seconds} s");
     assert_eq!(
         bench.state(),
-        State::Wheels(WheelMotion::Drive(firmware::fsm::Direction::Forward))
+        State::Wheels(WheelMotion::Drive(
+            firmware::control::fsm::Direction::Forward
+        ))
     );
     // The fold: front hips at +50°, back hips at −45° (see `Posture::ROBOT`).
     let front_hip = bench.joints_rad[1];
@@ -162,12 +166,12 @@ fn trot_from_the_wheels_stands_up_first() {
     bench.tick();
     assert_eq!(
         bench.state(),
-        State::Standing(LegMotion::Trot(firmware::fsm::Direction::Forward))
+        State::Standing(LegMotion::Trot(firmware::control::fsm::Direction::Forward))
     );
     bench.run(400);
     assert_eq!(
         bench.state(),
-        State::Legs(LegMotion::Trot(firmware::fsm::Direction::Forward))
+        State::Legs(LegMotion::Trot(firmware::control::fsm::Direction::Forward))
     );
     // And the legs now move: the gait, not a frozen pose.
     let a = bench.tick().leg_targets_rad;

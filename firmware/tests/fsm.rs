@@ -1,7 +1,7 @@
-//! The transition table of `firmware::fsm`, checked cell by cell, and the sequences a robot
+//! The transition table of `firmware::control::fsm`, checked cell by cell, and the sequences a robot
 //! goes through.
 
-use firmware::fsm::{Direction, Event, LegMotion, State, WheelMotion};
+use firmware::control::fsm::{Direction, Event, LegMotion, State, WheelMotion};
 use protocol::{ControllerMode, TeleopMode};
 
 use Direction::{Backward, Forward};

@@ -3,11 +3,11 @@
 //! body-height band.
 
 use firmware::config::Config;
-use firmware::fsm::Direction;
-use firmware::gait::{Generator, Trot, TrotParams};
-use firmware::kinematics::{leg_fk, LegJoints};
-use firmware::phase::{Phase, PhaseStep};
-use firmware::sine_gait::SineGait;
+use firmware::control::fsm::Direction;
+use firmware::legs::gait::{Generator, Trot, TrotParams};
+use firmware::legs::kinematics::{leg_fk, LegJoints};
+use firmware::legs::phase::{Phase, PhaseStep};
+use firmware::legs::sine_gait::SineGait;
 use firmware::time::TickRate;
 use protocol::Leg;
 

@@ -1,7 +1,7 @@
 //! The IK and FK of one leg: the report's worked example, both branches, the accuracy budget
 //! over the whole reachable workspace, and the errors.
 
-use firmware::kinematics::{
+use firmware::legs::kinematics::{
     leg_fk, leg_ik, planar_fk, planar_ik, FootTarget, IkError, KneeBranch, LegGeometry, LegJoints,
     PlanarAngles, PlanarPose,
 };

@@ -12,8 +12,8 @@ use common::{command, Ticks};
 
 use std::collections::HashMap;
 
-use firmware::controller::Output;
-use firmware::fsm::{Direction, LegMotion, State, WheelMotion};
+use firmware::control::controller::Output;
+use firmware::control::fsm::{Direction, LegMotion, State, WheelMotion};
 use firmware::{Config, Node, Tick};
 use protocol::{AnyMessage, ControllerMode, FaultFlags, RejectCause, TeleopHeartbeat, TeleopMode};
 

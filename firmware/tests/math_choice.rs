@@ -2,7 +2,7 @@
 //! and the IK's worst round-trip error over a dense grid of the leg's workspace. Run with
 //! `--nocapture` to see the figures quoted in the module docs.
 
-use firmware::kinematics::{leg_fk, leg_ik, KneeBranch, LegGeometry, LegJoints};
+use firmware::legs::kinematics::{leg_fk, leg_ik, KneeBranch, LegGeometry, LegJoints};
 use firmware::limits::{Joint, JointLimits};
 use micromath::F32Ext;
 

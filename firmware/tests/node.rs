@@ -2,7 +2,7 @@
 
 mod common;
 
-use firmware::fsm::{Direction, LegMotion, State, WheelMotion};
+use firmware::control::fsm::{Direction, LegMotion, State, WheelMotion};
 use firmware::node::TELEOP_COMMANDS_PER_TICK;
 use firmware::{Config, Node, Tick};
 use protocol::{

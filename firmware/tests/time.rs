@@ -1,7 +1,7 @@
 //! Integer time: durations in ticks, watchdogs across the counter wrap.
 
-use firmware::safety::Watchdog;
-use firmware::smoothing::Smoother;
+use firmware::control::safety::Watchdog;
+use firmware::legs::smoothing::Smoother;
 use firmware::{Tick, TickRate};
 
 #[test]

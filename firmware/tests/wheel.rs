@@ -1,6 +1,6 @@
 //! The turn loop's anti-windup and the torque mixer.
 
-use firmware::wheel::{mix, SpeedLoop, SpeedLoopGains};
+use firmware::wheels::wheel::{mix, SpeedLoop, SpeedLoopGains};
 
 const GAINS: SpeedLoopGains = SpeedLoopGains::TURN;
 

@@ -8,6 +8,7 @@
 //!   and its bus, for fault-injection tests, and the plans that say how;
 //! - [`candump`]: the one reader and writer of the can-utils log format (`candump -L`,
 //!   `canplayer`, `cansend`);
+//! - [`port`]: a bus as an `embedded-can` port, for the firmware's service loop;
 //! - [`logging`]: `tracing` set up the same way in every host program.
 
 #![deny(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
@@ -19,6 +20,7 @@ pub mod fault_plan;
 pub mod faulty_bus;
 pub mod inproc_bus;
 pub mod logging;
+pub mod port;
 pub mod socketcan_bus;
 
 pub use bus::{Bus, BusError};

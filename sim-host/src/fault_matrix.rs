@@ -6,7 +6,7 @@
 
 use std::path::Path;
 
-use firmware::fsm::{LegMotion, State, WheelMotion};
+use firmware::control::fsm::{LegMotion, State, WheelMotion};
 use host_can::fault_plan::{feedback_nodes, FaultPlan, Faults};
 use protocol::{
     AnyMessage, EStop, EStopAction, FaultFlags, MessageId, NodeId, RejectCause, TeleopMode,

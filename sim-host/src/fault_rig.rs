@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use firmware::fsm::State;
+use firmware::control::fsm::State;
 use host_can::bus::Bus;
 use host_can::fault_plan::Faults;
 use host_can::faulty_bus::{FaultStats, FaultyBus};

@@ -6,14 +6,17 @@
 //! watches to notice a simulator that restarted (its SYNC tick went back).
 
 use firmware::config::Config;
-use firmware::controller::{ConfigError, Output};
+use firmware::control::controller::{ConfigError, Output};
+use firmware::node::service::{self, Drain};
 use firmware::node::Node;
 use firmware::time::Tick;
-use protocol::{decode_frame, AnyMessage, MessageId};
-
-use host_can::bus::{Bus, BusError};
+use host_can::bus::BusError;
 use host_can::inproc_bus::InprocEndpoint;
-use std::time::Duration;
+use host_can::port::{BusPort, Wait};
+
+/// Most frames taken per control tick: a bound for a flooded bus, far above what one cycle
+/// carries (the rest waits for the next tick).
+const RX_LIMIT: u32 = 1 << 20;
 
 /// The firmware node and its bus endpoint.
 #[derive(Debug)]
@@ -44,32 +47,19 @@ impl InprocController {
     /// Takes every frame waiting on the bus, runs one control tick, sends its frames.
     pub fn service(&mut self) -> Result<(), BusError> {
         let now = self.tick;
-        while let Some(frame) = self.bus.recv(Duration::ZERO)? {
-            if self.node.on_frame(now, frame.id(), frame.data()).is_err() {
-                self.rejected += 1;
-                continue;
-            }
-            if frame.id() == MessageId::Sync.raw() {
-                self.watch_sync(&frame);
-            }
+        let mut port = BusPort::new(&mut self.bus, Wait::Never);
+        let received = service::receive(&mut self.node, now, &mut port, Drain::All, RX_LIMIT)?;
+        let sent = service::transmit(&mut self.node, now, &mut port)?;
+        self.rejected += u64::from(received.rejected);
+        if let Some(tick) = received.sync_tick {
+            self.watch_sync(tick);
         }
-        let (output, frames) = self.node.poll(now);
-        self.last_output = Some(output);
-        for frame in &frames {
-            self.bus.send(frame)?;
-        }
+        self.last_output = Some(sent.output);
         self.tick = now.plus(1);
         Ok(())
     }
 
-    fn watch_sync(&mut self, frame: &protocol::Frame) {
-        let Ok(decoded) = decode_frame(frame.id(), frame.data()) else {
-            return;
-        };
-        let AnyMessage::Sync(sync) = decoded.message else {
-            return;
-        };
-        let tick = sync.tick.raw();
+    fn watch_sync(&mut self, tick: u32) {
         if self.last_sync.is_some_and(|last| tick <= last) {
             self.sim_restarts += 1;
             tracing::warn!(

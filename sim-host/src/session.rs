@@ -143,7 +143,7 @@ pub enum SessionError {
     ControlRate(u32),
     /// The firmware's configuration was rejected.
     #[error("the firmware rejected its configuration: {0:?}")]
-    Firmware(firmware::controller::ConfigError),
+    Firmware(firmware::control::controller::ConfigError),
     /// Rendering frames.
     #[cfg(feature = "renderer")]
     #[error(transparent)]

@@ -1,6 +1,6 @@
 //! `cargo xtask pil [--record]`: processor-in-the-loop on an emulated Cortex-M4F.
 //!
-//! The control core (`firmware/pil`, the same `Node` and `firmware::can` glue as the STM32
+//! The control core (`firmware/pil`, the same `Node` and `firmware::node::service` glue as the STM32
 //! image) runs in QEMU's `mps2-an386` with `-icount shift=0` against the frames the firmware
 //! received in a recorded closed-loop run (`firmware/pil/recording.pil`), and this task checks
 //! that every frame it sends equals, field by field, what the host build of the core sends for

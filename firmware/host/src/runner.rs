@@ -13,11 +13,21 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use firmware::config::Config;
+use firmware::node::service::{self, Drain};
 use firmware::node::Node;
 use firmware::time::{Tick, TickRate};
-use protocol::{decode_frame, AnyMessage, MessageId, RejectCause};
-
+use host_can::port::{BusPort, Wait};
 use host_can::{Bus, BusError};
+use protocol::RejectCause;
+
+/// Most frames taken in one call of the service loop: a bound for a flooded bus, far above
+/// what one control period carries (a call that reaches it is simply followed by another, after
+/// the stop flag and the idle timeout are looked at).
+const RX_LIMIT: u32 = 256;
+
+/// Lockstep: how long one wait for the simulator's next frame lasts before the runner looks at
+/// its stop flag and idle timeout again.
+const LOCKSTEP_POLL: Duration = Duration::from_millis(50);
 
 /// How the runner keeps time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -67,7 +77,7 @@ pub enum RunnerError {
     Rate(u32),
     /// The firmware rejected its configuration.
     #[error("the firmware rejected its configuration: {0:?}")]
-    Config(firmware::controller::ConfigError),
+    Config(firmware::control::controller::ConfigError),
     /// The bus failed.
     #[error(transparent)]
     Bus(#[from] BusError),
@@ -109,7 +119,10 @@ fn lockstep(
     let mut next = Tick(0);
     let mut last_sync = Instant::now();
     while !done(&config, stats, stop) {
-        let Some(frame) = bus.recv(Duration::from_millis(50))? else {
+        let mut port = BusPort::new(bus, Wait::PerFrame(LOCKSTEP_POLL));
+        let received = service::receive(node, next, &mut port, Drain::ThroughSync, RX_LIMIT)?;
+        stats.frames_in += u64::from(received.frames);
+        let Some(sync_tick) = received.sync_tick else {
             if let Some(limit) = config.idle_timeout {
                 if last_sync.elapsed() > limit {
                     return Err(RunnerError::NoSync(limit));
@@ -117,26 +130,10 @@ fn lockstep(
             }
             continue;
         };
-        stats.frames_in += 1;
-        if node.on_frame(next, frame.id(), frame.data()).is_err() {
-            continue;
-        }
-        if frame.id() != MessageId::Sync.raw() {
-            continue;
-        }
-        let Ok(decoded) = decode_frame(frame.id(), frame.data()) else {
-            continue;
-        };
-        let AnyMessage::Sync(sync) = decoded.message else {
-            continue;
-        };
         last_sync = Instant::now();
-        let tick = Tick(sync.tick.raw());
-        let (_, frames) = node.poll(tick);
-        for out in &frames {
-            bus.send(out)?;
-            stats.frames_out += 1;
-        }
+        let tick = Tick(sync_tick);
+        let sent = service::transmit(node, tick, &mut port)?;
+        stats.frames_out += u64::from(sent.sent);
         stats.ticks += 1;
         next = tick.plus(1);
     }
@@ -158,29 +155,21 @@ fn timer(
     let mut slot: u64 = 0;
     while !done(&config, stats, stop) {
         slot = current_slot(slot, start.elapsed(), period, &mut stats.overruns);
-        while let Some(frame) = bus.recv(Duration::ZERO)? {
-            stats.frames_in += 1;
-            let _ = node.on_frame(tick, frame.id(), frame.data());
-        }
-        let (_, frames) = node.poll(tick);
-        for out in &frames {
-            bus.send(out)?;
-            stats.frames_out += 1;
-        }
+        let mut port = BusPort::new(&mut *bus, Wait::Never);
+        let received = service::receive(node, tick, &mut port, Drain::All, RX_LIMIT)?;
+        stats.frames_in += u64::from(received.frames);
+        let sent = service::transmit(node, tick, &mut port)?;
+        stats.frames_out += u64::from(sent.sent);
         stats.ticks += 1;
         tick = tick.plus(1);
         bus.end_cycle()?;
         slot += 1;
         let deadline = start + period * u32::try_from(slot).unwrap_or(u32::MAX);
         // Wait for the next tick, taking frames as they come so that they are timely.
-        while let Some(left) = deadline.checked_duration_since(Instant::now()) {
-            if left.is_zero() {
-                break;
-            }
-            if let Some(frame) = bus.recv(left)? {
-                stats.frames_in += 1;
-                let _ = node.on_frame(tick, frame.id(), frame.data());
-            }
+        while Instant::now() < deadline {
+            let mut port = BusPort::new(&mut *bus, Wait::Until(deadline));
+            let received = service::receive(node, tick, &mut port, Drain::All, RX_LIMIT)?;
+            stats.frames_in += u64::from(received.frames);
         }
     }
     Ok(())
@@ -205,9 +194,7 @@ fn current_slot(slot: u64, elapsed: Duration, period: Duration, lost: &mut u64) 
 /// Zero wheel torque and torque-free legs, in sequence with the node's commands, so that the
 /// drives stop now instead of after their 100 ms timeout.
 fn send_stop(bus: &mut dyn Bus, node: &mut Node, stats: &mut RunnerStats) -> Result<(), BusError> {
-    for frame in &node.stop_frames() {
-        bus.send(frame)?;
-        stats.frames_out += 1;
-    }
+    let mut port = BusPort::new(bus, Wait::Never);
+    stats.frames_out += u64::from(service::send_all(&mut port, &node.stop_frames())?);
     Ok(())
 }

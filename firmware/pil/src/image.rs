@@ -7,12 +7,12 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hio};
-use firmware::can::{self, FdFrame};
+use firmware::node::service::{self, Drain};
 use firmware::{Config, Node, Tick, TickRate};
-use heapless::Vec;
 
 use crate::inputs::{Inputs, MAX_FRAMES};
 use crate::line::Line;
+use crate::recorded::Recorded;
 
 /// The recorded inputs, prepared by `cargo xtask pil`.
 static INPUTS: &[u8] = include_bytes!(env!("PIL_INPUTS"));
@@ -69,34 +69,22 @@ fn main() -> ! {
     let Ok(mut node) = Node::new(Config::ROBOT.at_rate(rate)) else {
         fail("config rejected")
     };
-    let mut frames: Vec<FdFrame, MAX_FRAMES> = Vec::new();
+    let mut port = Recorded::new();
     let mut done = 0_u32;
     for k in 0..inputs.ticks {
-        if inputs.next_tick(&mut frames).is_none() {
+        if inputs.next_tick(port.inbox()).is_none() {
             fail("truncated input file");
         }
         let now = Tick(inputs.first_tick.wrapping_add(k));
         let start = SYST::get_current();
-        for frame in &frames {
-            let _ = can::receive(&mut node, now, frame);
-        }
-        let (_, sent) = node.poll(now);
-        let mut out_frames: Vec<FdFrame, 4> = Vec::new();
-        for frame in &sent {
-            if let Some(f) = can::transmit::<FdFrame>(frame) {
-                let _ = out_frames.push(f);
-            }
-        }
+        // The same calls as the board's loop: every recorded frame of the tick, then the tick.
+        let _ = service::receive(&mut node, now, &mut port, Drain::All, MAX_FRAMES as u32);
+        let _ = service::transmit(&mut node, now, &mut port);
         let cost = elapsed(start);
         line.str("T ").dec(now.0).str(" ").dec(cost).send(&mut out);
-        for f in &out_frames {
-            use embedded_can::Frame as _;
-            let id = match f.id() {
-                embedded_can::Id::Standard(id) => id.as_raw(),
-                embedded_can::Id::Extended(_) => 0xFFFF,
-            };
+        for f in port.sent() {
             line.str("F ")
-                .hex(&id.to_be_bytes())
+                .hex(&f.id().to_be_bytes())
                 .str(" ")
                 .hex(f.data())
                 .send(&mut out);

@@ -2,9 +2,8 @@
 //! first tick u32, tick count u32, then per tick a frame count u8 and per frame id u16,
 //! length u8, data; little-endian.
 
-use embedded_can::{Frame as _, StandardId};
-use firmware::can::FdFrame;
 use heapless::Vec;
+use protocol::Frame;
 
 /// Most frames one tick may carry.
 pub const MAX_FRAMES: usize = 24;
@@ -37,13 +36,13 @@ impl Inputs {
 
     /// The next tick's frames into `frames` (cleared first); `None` at the end or on a
     /// malformed record.
-    pub fn next_tick(&mut self, frames: &mut Vec<FdFrame, MAX_FRAMES>) -> Option<()> {
+    pub fn next_tick(&mut self, frames: &mut Vec<Frame, MAX_FRAMES>) -> Option<()> {
         frames.clear();
         let count = self.cursor.u8()?;
         for _ in 0..count {
-            let id = StandardId::new(self.cursor.u16()?)?;
+            let id = self.cursor.u16()?;
             let len = usize::from(self.cursor.u8()?);
-            let frame = FdFrame::new(id, self.cursor.take(len)?)?;
+            let frame = Frame::new(id, self.cursor.take(len)?)?;
             frames.push(frame).ok()?;
         }
         Some(())

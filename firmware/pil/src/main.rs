@@ -5,9 +5,9 @@
 //! SSRAM1 at 0x0000_0000 for code, 128 KiB — the STM32G474's RAM size — of ZBT SSRAM2/3 at
 //! 0x2000_0000 for data and stack), turns the committed recording into the input file embedded here
 //! (`PIL_INPUTS`), builds, runs QEMU with `-icount shift=0` and compares the frames with the
-//! host build's. Each tick the image gives the [`firmware::Node`] the frames recorded for it
-//! through [`firmware::can::receive`] and runs [`firmware::Node::poll`] — the same calls as the
-//! board image — timing both with SysTick, then prints (semihosting):
+//! host build's. Each tick the firmware's one service loop ([`firmware::node::service`], as on
+//! the board) gives the [`firmware::Node`] the frames recorded for it and runs the tick, through
+//! a port over the recording; the image times both with SysTick, then prints (semihosting):
 //!
 //! ```text
 //! PIL-CAL <instructions> <systick ticks>   a calibration loop of known length
@@ -31,6 +31,8 @@ mod image;
 mod inputs;
 #[cfg(target_os = "none")]
 mod line;
+#[cfg(target_os = "none")]
+mod recorded;
 
 #[cfg(not(target_os = "none"))]
 fn main() {

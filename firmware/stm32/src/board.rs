@@ -3,7 +3,7 @@
 use core::panic::PanicInfo;
 
 use cortex_m_rt::entry;
-use firmware::can::{self, FdFrame};
+use firmware::node::service::{self, Drain};
 use firmware::{Config, Node, Tick};
 use stm32g4xx_hal::can::CanExt;
 use stm32g4xx_hal::gpio::GpioExt;
@@ -22,7 +22,7 @@ use crate::timer::ControlTimer;
 const CONFIG: Config = Config::ROBOT;
 
 /// Frames taken from the receive FIFO per pass of the loop (the FIFO holds 3).
-const RX_PER_PASS: usize = 8;
+const RX_PER_PASS: u32 = 8;
 
 #[entry]
 fn main() -> ! {
@@ -63,19 +63,11 @@ fn main() -> ! {
     };
     let mut now = Tick(0);
     loop {
-        // Frames that arrive before tick `now` runs belong to it.
-        for _ in 0..RX_PER_PASS {
-            let Some(frame) = port.receive() else { break };
-            // Rejections are counted by the node and reported on the bus.
-            let _ = can::receive(&mut node, now, &frame);
-        }
+        // Frames that arrive before tick `now` runs belong to it. Rejections are counted by
+        // the node and reported on the bus; the port cannot fail.
+        let _ = service::receive(&mut node, now, &mut port, Drain::All, RX_PER_PASS);
         if timer.due() {
-            let (_, frames) = node.poll(now);
-            for frame in &frames {
-                if let Some(out) = can::transmit::<FdFrame>(frame) {
-                    port.transmit(&out);
-                }
-            }
+            let _ = service::transmit(&mut node, now, &mut port);
             now = now.plus(1);
         }
     }

@@ -1,28 +1,30 @@
 //! The thin adapter between the HAL's FDCAN driver (`fdcan` crate, through `stm32g4xx-hal`) and
-//! `embedded_can::Frame`: neither implements the embedded-can driver traits, so this is where
-//! their frame headers become [`FdFrame`]s and back.
+//! the control core: neither implements the embedded-can driver traits, so this port does —
+//! [`embedded_can::nb::Can`] with the protocol's [`Frame`] — and the core's one service loop
+//! ([`firmware::node::service`]) drives it.
 //!
 //! Bus timing (from the 80 MHz PLL "Q" kernel clock): 1 Mbit/s arbitration (prescaler 2, 40 tq,
 //! sample point 80 %) and 5 Mbit/s data (prescaler 1, 16 tq, sample point 81 %, transceiver
 //! delay compensation on), CAN FD with bit-rate switching, every standard id into FIFO 0.
 
+use core::convert::Infallible;
 use core::num::{NonZeroU16, NonZeroU8};
 
-use embedded_can::{Frame as _, Id, StandardId};
+use embedded_can::nb::Can;
 use fdcan::config::{DataBitTiming, FrameTransmissionConfig, NominalBitTiming};
 use fdcan::filter::{StandardFilter, StandardFilterSlot};
 use fdcan::frame::{FrameFormat, TxFrameHeader};
 use fdcan::{FdCan, Instance, NormalOperationMode, ReceiveOverrun};
-use firmware::can::{FdFrame, MAX_FD_LEN};
+use protocol::dlc::MAX_FD_LEN;
+use protocol::Frame;
 
-/// How often a frame waits for a free transmit buffer before it is dropped (each try is a
-/// register read; a 64-byte FD frame takes ~140 µs on the bus).
-const TX_TRIES: u32 = 20_000;
+/// Frames the receive FIFO can hold: the most one `receive` skips before it answers.
+const RX_FIFO_DEPTH: usize = 3;
 
 /// The FDCAN in normal operation, seen as frames.
 pub struct FdcanPort<I: Instance> {
     can: FdCan<I, NormalOperationMode>,
-    dropped: u32,
+    foreign: u32,
 }
 
 impl<I: Instance> FdcanPort<I> {
@@ -49,69 +51,82 @@ impl<I: Instance> FdcanPort<I> {
         );
         Some(Self {
             can: can.into_normal(),
-            dropped: 0,
+            foreign: 0,
         })
     }
 
-    /// The next received frame, if any.
-    pub fn receive(&mut self) -> Option<FdFrame> {
-        let mut buffer = [0_u8; MAX_FD_LEN];
-        let info = match self.can.receive0(&mut buffer) {
-            // An overrun lost older frames (the node's sequence checks count them); this one
-            // is good.
-            Ok(ReceiveOverrun::NoOverrun(info) | ReceiveOverrun::Overrun(info)) => info,
-            Err(_) => return None,
-        };
-        let id: Id = match info.id {
-            fdcan::id::Id::Standard(id) => StandardId::new(id.as_raw())?.into(),
-            fdcan::id::Id::Extended(id) => embedded_can::ExtendedId::new(id.as_raw())?.into(),
-        };
-        if info.rtr {
-            return None;
+    /// The next frame of this bus in the receive FIFO, skipping (and counting) what the bus
+    /// does not carry: extended ids and remote frames.
+    fn next_frame(&mut self) -> Option<Frame> {
+        for _ in 0..RX_FIFO_DEPTH {
+            let mut buffer = [0_u8; MAX_FD_LEN];
+            let info = match self.can.receive0(&mut buffer) {
+                // An overrun lost older frames (the node's sequence checks count them); this
+                // one is good.
+                Ok(ReceiveOverrun::NoOverrun(info) | ReceiveOverrun::Overrun(info)) => info,
+                Err(_) => return None,
+            };
+            let frame = match info.id {
+                fdcan::id::Id::Standard(id) if !info.rtr => buffer
+                    .get(..usize::from(info.len))
+                    .and_then(|data| Frame::new(id.as_raw(), data)),
+                _ => None,
+            };
+            match frame {
+                Some(frame) => return Some(frame),
+                None => self.foreign = self.foreign.saturating_add(1),
+            }
         }
-        FdFrame::new(id, buffer.get(..usize::from(info.len))?)
+        None
     }
 
-    /// Queues `frame` for transmission, waiting (bounded) for a free buffer; a frame that
-    /// finds none is dropped and counted.
-    pub fn transmit(&mut self, frame: &FdFrame) {
-        let id: fdcan::id::Id = match frame.id() {
-            Id::Standard(id) => match fdcan::id::StandardId::new(id.as_raw()) {
-                Some(id) => id.into(),
-                None => return self.drop_one(),
-            },
-            Id::Extended(_) => return self.drop_one(),
+    /// Frames received that this bus does not carry (extended ids, remote frames).
+    #[allow(dead_code)]
+    pub fn foreign(&self) -> u32 {
+        self.foreign
+    }
+}
+
+impl<I: Instance> Can for FdcanPort<I> {
+    type Frame = Frame;
+    type Error = Infallible;
+
+    /// Queues `frame` with bit-rate switching. A full queue takes it only in place of a
+    /// lower-priority frame, which is returned (lost); otherwise it asks to wait.
+    fn transmit(&mut self, frame: &Frame) -> nb::Result<Option<Frame>, Infallible> {
+        let Some(id) = fdcan::id::StandardId::new(frame.id()) else {
+            // `Frame` holds 11-bit ids only, so this cannot happen; refusing is the safe answer.
+            return Ok(Some(*frame));
         };
         let header = TxFrameHeader {
-            len: u8::try_from(frame.dlc()).unwrap_or(0),
+            len: u8::try_from(frame.data().len()).unwrap_or(0),
             frame_format: FrameFormat::Fdcan,
-            id,
+            id: id.into(),
             bit_rate_switching: true,
             marker: None,
         };
-        for _ in 0..TX_TRIES {
-            // A full queue takes the frame only in place of a lower-priority one (which is then
-            // lost); otherwise it asks to wait.
-            match self
-                .can
-                .transmit_preserve(header, frame.data(), &mut |_, _, _| ())
-            {
-                Ok(None) => return,
-                Ok(Some(())) => return self.drop_one(),
-                Err(nb::Error::WouldBlock) => continue,
-                Err(nb::Error::Other(never)) => match never {},
-            }
-        }
-        self.drop_one();
+        let replaced =
+            self.can
+                .transmit_preserve(header, frame.data(), &mut |_, header, words| {
+                    replaced_frame(&header, words)
+                })?;
+        // A replaced frame that cannot be rebuilt is still reported as lost.
+        Ok(replaced.map(|lost| lost.unwrap_or(*frame)))
     }
 
-    fn drop_one(&mut self) {
-        self.dropped = self.dropped.saturating_add(1);
+    fn receive(&mut self) -> nb::Result<Frame, Infallible> {
+        self.next_frame().ok_or(nb::Error::WouldBlock)
     }
+}
 
-    /// Frames dropped on transmit.
-    #[allow(dead_code)]
-    pub fn dropped(&self) -> u32 {
-        self.dropped
+/// The frame in a transmit mailbox that a higher-priority one replaced.
+fn replaced_frame(header: &TxFrameHeader, words: &[u32]) -> Option<Frame> {
+    let fdcan::id::Id::Standard(id) = header.id else {
+        return None;
+    };
+    let mut bytes = [0_u8; MAX_FD_LEN];
+    for (chunk, word) in bytes.chunks_exact_mut(4).zip(words) {
+        chunk.copy_from_slice(&word.to_le_bytes());
     }
+    Frame::new(id.as_raw(), bytes.get(..usize::from(header.len))?)
 }

@@ -30,10 +30,10 @@ pub fn standing_joints_rad(config: &Config) -> [f32; 16] {
 /// A bench stepped one control tick at a time.
 pub trait Ticks {
     /// One tick; its output.
-    fn tick(&mut self) -> firmware::controller::Output;
+    fn tick(&mut self) -> firmware::control::controller::Output;
 
     /// `ticks` ticks (at least one); the last output.
-    fn run(&mut self, ticks: u32) -> firmware::controller::Output {
+    fn run(&mut self, ticks: u32) -> firmware::control::controller::Output {
         let mut last = self.tick();
         for _ in 1..ticks {
             last = self.tick();

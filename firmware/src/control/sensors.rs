@@ -3,7 +3,7 @@
 use protocol::{Imu, Leg, LegFeedback, WheelFeedback};
 
 use crate::attitude::Attitude;
-use crate::safety::Watchdog;
+use crate::control::safety::Watchdog;
 use crate::time::Tick;
 
 /// The newest samples and how fresh they are.

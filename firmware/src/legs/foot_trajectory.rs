@@ -12,8 +12,8 @@
 
 use core::f32::consts::PI;
 
+use crate::legs::phase::Phase;
 use crate::math::{cos, sin};
-use crate::phase::Phase;
 
 /// Shape of the foot path.
 #[derive(Debug, Clone, Copy, PartialEq)]

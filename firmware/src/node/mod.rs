@@ -15,6 +15,10 @@
 //! protocol's bus schedule ([`protocol::busload::SCHEDULE`]): wheel torques every tick, leg
 //! targets at up to 250 Hz, status at 50 Hz, the reject counters at 10 Hz.
 
+pub mod link;
+pub mod rate_limit;
+pub mod service;
+
 use heapless::Vec;
 use protocol::busload::SCHEDULE;
 use protocol::{
@@ -23,10 +27,10 @@ use protocol::{
 };
 
 use crate::config::Config;
-use crate::controller::{ConfigError, Controller, Output};
-use crate::link::LinkMonitor;
-use crate::rate_limit::TickBudget;
+use crate::control::controller::{ConfigError, Controller, Output};
 use crate::time::Tick;
+use link::LinkMonitor;
+use rate_limit::TickBudget;
 
 /// Most operator commands ([`MessageId::TeleopCommand`]) handed to the controller per control
 /// tick; more are refused as [`DecodeError::RateLimited`]. The teleop sends one every 20 ms and

@@ -5,7 +5,7 @@
 
 use protocol::{TeleopCommand, TeleopMode};
 
-use crate::safety::Watchdog;
+use crate::control::safety::Watchdog;
 use crate::time::Tick;
 
 /// The operator's latest wishes.

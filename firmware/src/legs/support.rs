@@ -6,7 +6,7 @@
 //! hips, from the measured joint angles) plus the foot radius; the wheels touch once that
 //! height falls to the wheels' contact height (mount depth + wheel radius).
 
-use crate::kinematics::{leg_fk, LegGeometry, LegJoints};
+use crate::legs::kinematics::{leg_fk, LegGeometry, LegJoints};
 
 /// Dimensions that decide which part touches the ground.
 #[derive(Debug, Clone, Copy, PartialEq)]

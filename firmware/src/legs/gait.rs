@@ -7,13 +7,13 @@
 
 use protocol::Leg;
 
-use crate::foot_trajectory::FootTrajectory;
-use crate::fsm::Direction;
-use crate::kinematics::{IkError, LegGeometry, LegJoints};
+use crate::control::fsm::Direction;
+use crate::legs::foot_trajectory::FootTrajectory;
+use crate::legs::kinematics::{IkError, LegGeometry, LegJoints};
+use crate::legs::phase::{Phase, PhaseStep, HALF_CYCLE};
+use crate::legs::posture::Posture;
+use crate::legs::sine_gait::SineGait;
 use crate::limits::JointLimits;
-use crate::phase::{Phase, PhaseStep, HALF_CYCLE};
-use crate::posture::Posture;
-use crate::sine_gait::SineGait;
 use crate::time::TickRate;
 
 /// Which foot-motion generator drives the trot.

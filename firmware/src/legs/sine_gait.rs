@@ -2,9 +2,9 @@
 //! `hip2 = A_hip sin(ωt + φ)`, `knee = q_base + A_knee sin(ωt + φ)`, `ankle = A_ank sin(ωt + φ)`,
 //! hip abduction at zero.
 
-use crate::kinematics::LegJoints;
+use crate::legs::kinematics::LegJoints;
+use crate::legs::phase::Phase;
 use crate::math::sin;
-use crate::phase::Phase;
 
 /// Amplitudes and offset of the report's sinusoids.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -22,7 +22,7 @@
 //! clearance) on a stance line 0.35…0.37 m deep; the test
 //! `every_gait_pose_solves_across_the_body_height_band_and_speed_scales` holds it to that.
 
-use crate::kinematics::{leg_ik, FootTarget, IkError, KneeBranch, LegGeometry, LegJoints};
+use crate::legs::kinematics::{leg_ik, FootTarget, IkError, KneeBranch, LegGeometry, LegJoints};
 use crate::limits::JointLimits;
 use crate::math::deg_to_rad;
 

@@ -11,17 +11,17 @@
 
 use protocol::{AnyMessage, ControllerMode, Drive, DriveFlags, EStopAction, FaultFlags};
 
-use crate::balance::{Balance, BalanceInput};
 use crate::config::Config;
-use crate::fsm::{Direction, Event, LegMotion, State, WheelMotion};
-use crate::gait::Trot;
-use crate::kinematics::LegJoints;
-use crate::safety::{clamp_leg_targets, clamp_wheel_torques};
-use crate::sensors::Sensors;
-use crate::smoothing::Smoother;
-use crate::teleop::Teleop;
+use crate::control::fsm::{Direction, Event, LegMotion, State, WheelMotion};
+use crate::control::safety::{clamp_leg_targets, clamp_wheel_torques};
+use crate::control::sensors::Sensors;
+use crate::control::teleop::Teleop;
+use crate::legs::gait::Trot;
+use crate::legs::kinematics::LegJoints;
+use crate::legs::smoothing::Smoother;
 use crate::time::Tick;
-use crate::wheel::{mix, SpeedLoop};
+use crate::wheels::balance::{Balance, BalanceInput};
+use crate::wheels::wheel::{mix, SpeedLoop};
 
 /// What the controller commands this tick.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -152,7 +152,7 @@ impl Controller {
     }
 
     /// Tells the controller whether the bus is too lossy to move on (the node's
-    /// [`LinkMonitor`](crate::link::LinkMonitor) decides; call before [`Controller::step`]).
+    /// [`LinkMonitor`](crate::node::link::LinkMonitor) decides; call before [`Controller::step`]).
     ///
     /// When the link becomes degraded the controller stops once, as for a lost operator
     /// ([`Event::LinkDegraded`]: a trot stands still on four legs, a wheel drive brakes to a
@@ -350,7 +350,7 @@ impl Controller {
     }
 
     /// On the wheels the balance law always runs; while folding or standing up only once the
-    /// measured leg pose puts the wheels on the ground (see [`crate::support`]).
+    /// measured leg pose puts the wheels on the ground (see [`crate::legs::support`]).
     fn wheels_may_drive(&self) -> bool {
         matches!(self.state, State::Wheels(_))
             || self
