@@ -33,7 +33,7 @@ Tasks:
   dbc [--check]      regenerate protocol/hybrid_robot.dbc (--check: fail if the committed file is stale)
   busload            print the per-cycle frame schedule and the bus load at 250 Hz and 1 kHz
   bench [args]       criterion benchmarks (control step, raw MuJoCo step, closed-loop cycle), then a
-                     table of medians and steps per second
+                     table of medians and steps per second, also written into docs/measurements.md
                      (args go to criterion, e.g. `--measurement-time 3`)
   hil [--vm] [NAME]  the vcan hardware-in-the-loop suite: firmware and simulator as two processes
                      on a kernel vcan; natively where this kernel has vcan and you are root,
@@ -50,8 +50,8 @@ Tasks:
                      from the committed seeds; fails on a crash (--seeds: rewrite the seeds)
   faults [--check]   the fault matrix (lost, late, corrupted, replayed frames, a teleop flood,
                      silent feedback, a killed firmware, a restarted simulator, E-stops) on the
-                     closed loop in-process; writes its table into README.md (--check: fail if
-                     the README's table is stale)
+                     closed loop in-process; writes its table into docs/faults.md (--check: fail
+                     if the table there is stale)
   demo [options]     the report's demonstration, closed loop (STOP, W, S, A, L, K, X): sets up,
                      builds, runs scenarios/report_demo.toml with the firmware on the in-process
                      CAN bus; writes out/ (summary.json, telemetry.csv, bus.log, plots, frames)
