@@ -10,14 +10,14 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use host_can::bus::Bus;
 use host_can::inproc_bus::InprocBus;
 use protocol::TeleopMode;
-use sim_host::imu::ImuNoise;
-use sim_host::inproc_controller::InprocController;
-use sim_host::lockstep::{self, LockstepOptions};
-use sim_host::model::DEFAULT_MODEL;
-use sim_host::physics::Physics;
-use sim_host::recorder::Recorder;
+use sim_host::clock::lockstep::{self, LockstepOptions};
+use sim_host::output::recorder::Recorder;
+use sim_host::robot::imu::ImuNoise;
+use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::robot::physics::Physics;
 use sim_host::session::firmware_config;
-use sim_host::simulator::{Simulator, StartPose};
+use sim_host::session::inproc_controller::InprocController;
+use sim_host::session::simulator::{Simulator, StartPose};
 use teleop_core::scripted::{PlanStep, ScriptedTeleop};
 
 fn raw_step(c: &mut Criterion) {

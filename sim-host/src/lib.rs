@@ -1,37 +1,21 @@
 //! The hybrid wheel–leg robot in MuJoCo, presented on a CAN bus as its real hardware would be:
 //! four leg drives, a wheel drive and an IMU, each a CAN node with the `protocol` crate's frames,
-//! E2E checks and a command timeout.
+//! E2E checks and a command timeout. The buses come from `host_can` (one abstraction,
+//! in-process and SocketCAN).
 //!
-//! - [`physics`]: the model and its state (ground truth);
-//! - the buses come from `host_can` (one abstraction, in-process and SocketCAN);
-//! - [`leg_drive`], [`wheel_drive`], [`imu`], [`hardware`]: the emulated nodes;
-//! - [`lockstep`], [`realtime`]: the two clocks;
-//! - [`telemetry`], [`telemetry_csv`], [`candump`], [`plots`]: what a user looks at.
+//! The folders:
+//!
+//! - [`robot`]: the model and its state (ground truth), and the emulated hardware on the bus
+//!   (leg drives, wheel drive, IMU);
+//! - [`clock`]: the two clocks, lockstep (the simulator sends SYNC) and real time;
+//! - [`session`]: one closed-loop run, with the firmware in-process or over SocketCAN;
+//! - [`output`]: what a user looks at — telemetry CSV, the candump log, `summary.json`, plots,
+//!   rendered frames, the viewer;
+//! - [`faults`]: the fault matrix and the rig it runs on.
 
-pub mod drive_core;
+pub mod clock;
 pub mod error_chain;
-pub mod fault_matrix;
-pub mod fault_rig;
-pub mod hardware;
-pub mod imu;
-pub mod inproc_controller;
-pub mod leg_drive;
-pub mod lockstep;
-pub mod metrics;
-pub mod model;
-pub mod output_error;
-pub mod physics;
-pub mod plots;
-pub mod realtime;
-pub mod recorder;
-#[cfg(feature = "renderer")]
-pub mod render;
-pub mod run_stats;
+pub mod faults;
+pub mod output;
+pub mod robot;
 pub mod session;
-pub mod simulator;
-pub mod summary;
-pub mod telemetry;
-pub mod telemetry_csv;
-#[cfg(feature = "viewer")]
-pub mod viewer;
-pub mod wheel_drive;

@@ -11,10 +11,10 @@ use std::time::Duration;
 use clap::{Parser, Subcommand, ValueEnum};
 use host_can::fault_plan::Faults;
 use protocol::TeleopMode;
-use sim_host::imu::ImuNoise;
-use sim_host::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
+use sim_host::output::summary::{self, Summary};
+use sim_host::robot::imu::ImuNoise;
+use sim_host::robot::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
 use sim_host::session::{self, BusChoice, Clock, FrameSettings, SegmentSpec, SessionConfig};
-use sim_host::summary::{self, Summary};
 use teleop_core::scenario::{mode_name, Scenario};
 use teleop_core::scripted::PlanStep;
 
@@ -191,9 +191,9 @@ fn main() -> ExitCode {
 /// cannot be installed, Ctrl-C keeps its default effect (the process ends) and the run says so.
 fn faults(model: &std::path::Path) -> ExitCode {
     eprintln!("running the fault matrix (about a minute in release)…");
-    match sim_host::fault_matrix::run(model) {
+    match sim_host::faults::matrix::run(model) {
         Ok(cells) => {
-            print!("{}", sim_host::fault_matrix::markdown(&cells));
+            print!("{}", sim_host::faults::matrix::markdown(&cells));
             let failed = cells.iter().filter(|c| !c.pass).count();
             if failed == 0 {
                 ExitCode::SUCCESS

@@ -13,11 +13,11 @@ use protocol::{
     Angle, AnyMessage, DriveEnable, DriveFlags, DriveStatus, E2eCounter, EStop, EStopAction, Frame,
     Leg, LegFeedback, LegTargets, NodeId, Receiver, Torque, WheelCommand, WheelFeedback,
 };
-use sim_host::imu::ImuNoise;
-use sim_host::lockstep::{self, LockstepOptions};
-use sim_host::model::DEFAULT_MODEL;
-use sim_host::recorder::Recorder;
-use sim_host::simulator::{Simulator, StartPose};
+use sim_host::clock::lockstep::{self, LockstepOptions};
+use sim_host::output::recorder::Recorder;
+use sim_host::robot::imu::ImuNoise;
+use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::session::simulator::{Simulator, StartPose};
 
 const HZ: u32 = 250;
 

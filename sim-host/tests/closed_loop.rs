@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use sim_host::imu::ImuNoise;
-use sim_host::metrics::SegmentSummary;
-use sim_host::model::DEFAULT_MODEL;
+use sim_host::output::metrics::SegmentSummary;
+use sim_host::robot::imu::ImuNoise;
+use sim_host::robot::model::DEFAULT_MODEL;
 use sim_host::session::{self, BusChoice, Clock, SegmentSpec, SessionConfig};
 use teleop_core::scenario::{mode_name, Scenario};
 use teleop_core::scripted::PlanStep;

@@ -3,13 +3,13 @@
 
 use std::path::Path;
 
-use sim_host::fault_matrix;
-use sim_host::model::DEFAULT_MODEL;
+use sim_host::faults::matrix;
+use sim_host::robot::model::DEFAULT_MODEL;
 
 #[test]
 fn every_cell_of_the_fault_matrix_holds() {
-    let cells = fault_matrix::run(Path::new(DEFAULT_MODEL)).unwrap();
-    println!("{}", fault_matrix::markdown(&cells));
+    let cells = matrix::run(Path::new(DEFAULT_MODEL)).unwrap();
+    println!("{}", matrix::markdown(&cells));
     let failed: Vec<_> = cells.iter().filter(|c| !c.pass).collect();
     assert!(failed.is_empty(), "failed cells: {failed:#?}");
     // The matrix covers what the issue asks for, not a convenient subset.

@@ -3,9 +3,9 @@
 
 use std::path::Path;
 
-use sim_host::model::{ModelError, DEFAULT_MODEL, OBSTACLES_MODEL};
-use sim_host::physics::Physics;
-use sim_host::simulator::StartPose;
+use sim_host::robot::model::{ModelError, DEFAULT_MODEL, OBSTACLES_MODEL};
+use sim_host::robot::physics::Physics;
+use sim_host::session::simulator::StartPose;
 
 const STEPS_PER_S: usize = 250;
 
@@ -98,7 +98,7 @@ fn folded_on_free_wheels_it_tips_over() {
 fn the_obstacle_scene_has_the_robot_a_step_and_a_ramp() {
     let p = Physics::load(Path::new(OBSTACLES_MODEL)).expect("the obstacle scene loads");
     assert_eq!(p.timestep_s(), 0.004);
-    let ids = sim_host::model::obstacle_ids(&p).expect("step and ramp geoms");
+    let ids = sim_host::robot::model::obstacle_ids(&p).expect("step and ramp geoms");
     assert_eq!(ids.len(), 2);
 }
 

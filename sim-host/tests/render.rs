@@ -11,10 +11,10 @@ use std::collections::HashSet;
 use std::num::NonZeroU32;
 use std::path::{Path, PathBuf};
 
-use sim_host::imu::ImuNoise;
-use sim_host::model::DEFAULT_MODEL;
-use sim_host::render::{FrameOptions, FrameRenderer, RenderError};
-use sim_host::simulator::{Simulator, StartPose};
+use sim_host::output::render::{FrameOptions, FrameRenderer, RenderError};
+use sim_host::robot::imu::ImuNoise;
+use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::session::simulator::{Simulator, StartPose};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("sim-host-render-{}-{name}", std::process::id()));

@@ -9,11 +9,11 @@ use std::thread::JoinHandle;
 use std::time::Duration;
 
 use host_can::inproc_bus::InprocEndpoint;
-use sim_host::imu::ImuNoise;
+use sim_host::output::telemetry::TelemetryRow;
+use sim_host::robot::imu::ImuNoise;
 use sim_host::session::{
     self, Attach, BusChoice, Clock, SessionConfig, SessionError, SessionReport,
 };
-use sim_host::telemetry::TelemetryRow;
 
 use crate::app::SimView;
 
@@ -34,7 +34,7 @@ impl InprocOptions {
     /// The report's robot on flat ground in real time, for up to a day.
     pub fn realtime() -> Self {
         Self {
-            model: PathBuf::from(sim_host::model::DEFAULT_MODEL),
+            model: PathBuf::from(sim_host::robot::model::DEFAULT_MODEL),
             out_dir: None,
             clock: Clock::Realtime,
             duration_s: 86_400.0,

@@ -9,12 +9,12 @@ use std::time::{Duration, Instant};
 use host_can::bus::Bus;
 use host_can::inproc_bus::{InprocBus, InprocEndpoint};
 use protocol::{decode_frame, AnyMessage, ControllerMode, DriveEnable, FaultFlags, Frame};
-use sim_host::imu::ImuNoise;
-use sim_host::inproc_controller::InprocController;
-use sim_host::lockstep::{self, LockstepOptions};
-use sim_host::recorder::Recorder;
+use sim_host::clock::lockstep::{self, LockstepOptions};
+use sim_host::output::recorder::Recorder;
+use sim_host::robot::imu::ImuNoise;
 use sim_host::session::firmware_config;
-use sim_host::simulator::{Simulator, StartPose};
+use sim_host::session::inproc_controller::InprocController;
+use sim_host::session::simulator::{Simulator, StartPose};
 use teleop::app::App;
 use teleop::inproc::{InprocOptions, InprocRobot};
 use teleop_core::keys::Key;
@@ -41,7 +41,7 @@ fn lockstep_latency(
 ) -> u32 {
     let press_cycle = 250;
     let mut sim = Simulator::new(
-        std::path::Path::new(sim_host::model::DEFAULT_MODEL),
+        std::path::Path::new(sim_host::robot::model::DEFAULT_MODEL),
         250,
         StartPose::standing(),
         ImuNoise::default(),

@@ -9,9 +9,9 @@ use std::time::{Duration, Instant};
 
 use protocol::MessageId;
 
-use crate::recorder::Recorder;
-use crate::run_stats::{RunError, RunStats};
-use crate::simulator::Simulator;
+use crate::output::recorder::Recorder;
+use crate::session::run_stats::{RunError, RunStats};
+use crate::session::simulator::Simulator;
 use host_can::bus::Bus;
 
 /// Lockstep settings.

@@ -1,16 +1,16 @@
 //! The simulated robot: MuJoCo physics plus the emulated CAN nodes, advanced one control cycle
-//! at a time. Bus- and clock-agnostic: [`crate::lockstep`] and [`crate::realtime`] move frames
+//! at a time. Bus- and clock-agnostic: [`crate::clock::lockstep`] and [`crate::clock::realtime`] move frames
 //! between it and a [`host_can::bus::Bus`].
 
 use std::path::Path;
 
 use protocol::{AnyMessage, E2eCounter, EncodeError, Frame, Sync, Tick};
 
-use crate::hardware::Hardware;
-use crate::imu::ImuNoise;
-use crate::model::ModelError;
-use crate::physics::Physics;
-use crate::telemetry::TelemetryRow;
+use crate::output::telemetry::TelemetryRow;
+use crate::robot::hardware::Hardware;
+use crate::robot::imu::ImuNoise;
+use crate::robot::model::ModelError;
+use crate::robot::physics::Physics;
 
 /// How the simulation starts.
 #[derive(Debug, Clone, Copy, PartialEq)]

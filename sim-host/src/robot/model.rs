@@ -192,7 +192,7 @@ impl Layout {
 }
 
 /// Geom ids of the obstacle scene's `step` and `ramp`; `None` in a scene without them.
-pub fn obstacle_ids(physics: &crate::physics::Physics) -> Option<Vec<usize>> {
+pub fn obstacle_ids(physics: &crate::robot::physics::Physics) -> Option<Vec<usize>> {
     let model = physics.model();
     ["step", "ramp"]
         .iter()

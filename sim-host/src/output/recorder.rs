@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 
 use protocol::Frame;
 
-use crate::output_error::OutputError;
-use crate::telemetry::TelemetryRow;
+use crate::output::output_error::OutputError;
+use crate::output::telemetry::TelemetryRow;
 use host_can::candump::{CandumpWriter, LoggedFrame};
 
 /// The recorder of one run.

@@ -1,4 +1,4 @@
-//! The fault matrix: the closed loop ([`crate::fault_rig`]) under each fault of the bus and its
+//! The fault matrix: the closed loop ([`crate::faults::rig`]) under each fault of the bus and its
 //! peers, each cell judged from ground truth and the nodes' own counters. `sim-host faults`
 //! prints it; `cargo xtask faults` puts it in the README; `tests/faults.rs` asserts it.
 //!
@@ -13,8 +13,8 @@ use protocol::{
 };
 use teleop_core::scripted::PlanStep;
 
-use crate::fault_rig::{CycleRecord, Rig, PERIOD_US};
-use crate::run_stats::RunError;
+use crate::faults::rig::{CycleRecord, Rig, PERIOD_US};
+use crate::session::run_stats::RunError;
 use crate::session::SessionError;
 
 /// One judged cell.

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use crate::simulator::Simulator;
+use crate::session::simulator::Simulator;
 
 /// A joint counts as past its limit beyond this, rad (MuJoCo's limits are soft constraints:
 /// a loaded joint presses a fraction of a degree into them).

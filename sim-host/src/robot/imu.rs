@@ -7,7 +7,7 @@ use rand_distr::{Distribution, Normal};
 
 use protocol::{Acceleration, AngularRate, AnyMessage, E2eCounter, Imu, QuatComponent};
 
-use crate::physics::Physics;
+use crate::robot::physics::Physics;
 
 /// Noise and bias of the IMU. All zero by default: the ideal sensor.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]

@@ -15,15 +15,15 @@ use host_can::inproc_bus::{InprocBus, InprocEndpoint};
 use protocol::{FaultFlags, Frame, RejectCause, RejectCounters};
 use teleop_core::scripted::{PlanStep, ScriptedTeleop};
 
-use crate::drive_core::{Authority, DriveCore};
-use crate::imu::ImuNoise;
-use crate::inproc_controller::InprocController;
-use crate::lockstep;
-use crate::metrics::FALLEN_TILT_DEG;
-use crate::recorder::Recorder;
-use crate::run_stats::{RunError, RunStats};
+use crate::clock::lockstep;
+use crate::output::metrics::FALLEN_TILT_DEG;
+use crate::output::recorder::Recorder;
+use crate::robot::drive_core::{Authority, DriveCore};
+use crate::robot::imu::ImuNoise;
+use crate::session::inproc_controller::InprocController;
+use crate::session::run_stats::{RunError, RunStats};
+use crate::session::simulator::{Simulator, StartPose};
 use crate::session::{firmware_config, SessionError};
-use crate::simulator::{Simulator, StartPose};
 
 /// Control rate of the rig, Hz.
 pub const RIG_HZ: u32 = 250;

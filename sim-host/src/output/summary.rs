@@ -5,9 +5,9 @@ use std::path::Path;
 
 use serde::Serialize;
 
-use crate::metrics::SegmentSummary;
-use crate::output_error::OutputError;
-use crate::run_stats::RunStats;
+use crate::output::metrics::SegmentSummary;
+use crate::output::output_error::OutputError;
+use crate::session::run_stats::RunStats;
 
 /// The whole file.
 #[derive(Debug, Serialize)]

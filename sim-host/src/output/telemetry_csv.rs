@@ -6,8 +6,8 @@ use std::path::Path;
 
 use protocol::JOINT_NAMES;
 
-use crate::output_error::OutputError;
-use crate::telemetry::TelemetryRow;
+use crate::output::output_error::OutputError;
+use crate::output::telemetry::TelemetryRow;
 
 /// The CSV's column names, in order: time, torso position and attitude, one `<joint>_rad`
 /// column per leg joint in [`JOINT_NAMES`] order, wheel torques and speeds, foot forces, body contact, controller mode.

@@ -11,8 +11,8 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::{register_font, FontStyle};
 
-use crate::output_error::OutputError;
-use crate::telemetry::TelemetryRow;
+use crate::output::output_error::OutputError;
+use crate::output::telemetry::TelemetryRow;
 
 /// Width and height of every figure, pixels.
 pub const SIZE: (u32, u32) = (1000, 500);

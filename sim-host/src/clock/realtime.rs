@@ -5,9 +5,9 @@
 
 use std::time::{Duration, Instant};
 
-use crate::recorder::Recorder;
-use crate::run_stats::{RunError, RunStats};
-use crate::simulator::Simulator;
+use crate::output::recorder::Recorder;
+use crate::session::run_stats::{RunError, RunStats};
+use crate::session::simulator::Simulator;
 use host_can::bus::Bus;
 
 /// Real-time settings.
@@ -20,7 +20,7 @@ pub struct RealtimeOptions {
 }
 
 /// Runs `options.cycles` cycles on the wall clock. `peers(cycle)` runs right after the
-/// simulator has sent its feedback (see [`crate::lockstep::run`]); `observe` after each cycle.
+/// simulator has sent its feedback (see [`crate::clock::lockstep::run`]); `observe` after each cycle.
 pub fn run(
     sim: &mut Simulator,
     bus: &mut dyn Bus,

@@ -7,7 +7,7 @@ use std::path::Path;
 use mujoco_rs::prelude::{MjData, MjModel};
 use mujoco_rs::wrappers::mj_model::MjtObjBase as MjtObj;
 
-use crate::model::{load, Layout, ModelError};
+use crate::robot::model::{load, Layout, ModelError};
 
 /// Torso state from the simulator (ground truth).
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -2,7 +2,7 @@
 
 use std::time::Duration;
 
-use crate::output_error::OutputError;
+use crate::output::output_error::OutputError;
 use host_can::bus::BusError;
 
 /// Counters of one run.

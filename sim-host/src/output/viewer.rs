@@ -17,8 +17,8 @@ use mujoco_rs::error::MjDataError;
 use mujoco_rs::prelude::{MjData, MjModel};
 use mujoco_rs::viewer::{MjViewer, MjViewerError};
 
-use crate::physics::Physics;
-use crate::simulator::Simulator;
+use crate::robot::physics::Physics;
+use crate::session::simulator::Simulator;
 
 /// Shortest wall-clock time between two drawn frames (60 frames per second): syncing is cheap
 /// and happens every cycle, drawing is not and would slow a 250 Hz real-time run.

@@ -5,8 +5,8 @@ use protocol::{
     AnyMessage, E2eCounter, Frame, MessageId, Torque, WheelAngle, WheelFeedback, WheelVelocity,
 };
 
-use crate::drive_core::{Authority, DriveCore};
-use crate::physics::Physics;
+use crate::robot::drive_core::{Authority, DriveCore};
+use crate::robot::physics::Physics;
 
 /// The emulated wheel drive.
 #[derive(Debug, Clone)]

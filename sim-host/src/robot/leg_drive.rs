@@ -7,8 +7,8 @@ use protocol::{
     Torque,
 };
 
-use crate::drive_core::{Authority, DriveCore};
-use crate::physics::Physics;
+use crate::robot::drive_core::{Authority, DriveCore};
+use crate::robot::physics::Physics;
 
 /// The emulated drive of one leg.
 #[derive(Debug, Clone)]

@@ -20,8 +20,8 @@ use mujoco_rs::error::MjDataError;
 use mujoco_rs::prelude::{MjData, MjModel, MjtObjBase, MjvCamera};
 use mujoco_rs::renderer::{png, MjRenderer, RendererError};
 
-use crate::physics::Physics;
-use crate::simulator::Simulator;
+use crate::robot::physics::Physics;
+use crate::session::simulator::Simulator;
 
 /// The camera frames are rendered from unless told otherwise: `chase` in `hybrid_robot.xml`,
 /// which follows the robot's centre of mass from behind and to the side.

@@ -10,10 +10,10 @@ use protocol::{
     decode_frame, AnyMessage, ControllerMode, Drive, EncodeError, Frame, Leg, MessageId,
 };
 
-use crate::imu::{ImuNode, ImuNoise};
-use crate::leg_drive::LegDrive;
-use crate::physics::Physics;
-use crate::wheel_drive::WheelDrive;
+use crate::robot::imu::{ImuNode, ImuNoise};
+use crate::robot::leg_drive::LegDrive;
+use crate::robot::physics::Physics;
+use crate::robot::wheel_drive::WheelDrive;
 
 /// The robot's CAN nodes.
 #[derive(Debug, Clone)]

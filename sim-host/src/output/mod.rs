@@ -1,0 +1,16 @@
+//! What a run leaves for its user: the [`telemetry`] rows and their [`telemetry_csv`] file, the
+//! [`recorder`] that streams the bus to a candump log, the figures per segment ([`metrics`],
+//! [`summary`]), the [`plots`], rendered frames ([`render`], feature `renderer`) and the
+//! interactive [`viewer`] (feature `viewer`); [`output_error`] names the file that failed.
+
+pub mod metrics;
+pub mod output_error;
+pub mod plots;
+pub mod recorder;
+#[cfg(feature = "renderer")]
+pub mod render;
+pub mod summary;
+pub mod telemetry;
+pub mod telemetry_csv;
+#[cfg(feature = "viewer")]
+pub mod viewer;

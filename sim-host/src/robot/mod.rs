@@ -1,0 +1,11 @@
+//! The robot: its MuJoCo [`model`] and [`physics`] (ground truth), and the hardware a real
+//! robot puts on the bus, emulated — four [`leg_drive`]s and the [`wheel_drive`] (sharing
+//! [`drive_core`]), the [`imu`], all together in [`hardware`].
+
+pub mod drive_core;
+pub mod hardware;
+pub mod imu;
+pub mod leg_drive;
+pub mod model;
+pub mod physics;
+pub mod wheel_drive;
