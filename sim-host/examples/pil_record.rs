@@ -7,9 +7,7 @@
 //! is written down with the tick it belongs to. The plan: stand, trot forward (L), then W —
 //! which folds the legs, catches the robot on its wheels and drives off balancing.
 //!
-//! Output (the "raw" format the PIL image reads): `PIL1`, control rate u16, first tick u32,
-//! tick count u32, then per tick: frame count u8 and per frame id u16, length u8, data. All
-//! little-endian.
+//! Output: `pil-format`'s raw format (the one the PIL image reads).
 //!
 //! ```sh
 //! cargo run --release -p sim-host --example pil_record -- OUT.raw [SECONDS]
@@ -21,6 +19,7 @@ use firmware::node::Node;
 use firmware::time::Tick;
 use firmware_host::bus::Bus;
 use firmware_host::inproc_bus::InprocBus;
+use pil_format::Recording;
 use protocol::TeleopMode;
 use sim_host::imu::ImuNoise;
 use sim_host::lockstep::{self, LockstepOptions};
@@ -96,19 +95,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         peers,
         |_, _| true,
     )?;
-    let mut bytes = Vec::new();
-    bytes.extend_from_slice(b"PIL1");
-    bytes.extend_from_slice(&u16::try_from(CONTROL_HZ)?.to_le_bytes());
-    bytes.extend_from_slice(&0_u32.to_le_bytes());
-    bytes.extend_from_slice(&u32::try_from(ticks.len())?.to_le_bytes());
-    for frames in &ticks {
-        bytes.push(u8::try_from(frames.len())?);
-        for (id, data) in frames {
-            bytes.extend_from_slice(&id.to_le_bytes());
-            bytes.push(u8::try_from(data.len())?);
-            bytes.extend_from_slice(data);
-        }
-    }
+    let recording = Recording {
+        control_hz: u16::try_from(CONTROL_HZ)?,
+        first_tick: 0,
+        ticks,
+    };
+    let bytes = recording.to_raw()?;
     std::fs::write(&out, &bytes)?;
     // Where the controller's mode changed, to show what the recording covers.
     let mut changes = String::new();
@@ -124,8 +116,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     eprintln!(
         "pil_record: {} ticks, {} frames, {} bytes raw, missed cycles {}; modes:{changes}",
-        ticks.len(),
-        ticks.iter().map(Vec::len).sum::<usize>(),
+        recording.ticks.len(),
+        recording.ticks.iter().map(Vec::len).sum::<usize>(),
         bytes.len(),
         stats.missed_cycles
     );
