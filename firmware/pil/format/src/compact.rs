@@ -1,6 +1,6 @@
 //! The compact format (magic `PILZ`) the repository keeps: the raw layout with each frame's
 //! data XORed with the previous frame of its id and run-length coded (see the crate docs).
-//! Reading and writing it is [`crate::Recording`]'s (feature `alloc`): undoing the XOR needs
+//! Reading and writing it is `Recording`'s (feature `alloc`): undoing the XOR needs
 //! each id's previous frame, kept on the heap.
 
 #[cfg(feature = "alloc")]

@@ -16,7 +16,7 @@
 //!   followed by `n + 1` literal bytes, a byte `n ≥ 0x80` stands for `n − 0x7F` zero bytes.
 //!
 //! The core (header, errors, raw reader) is `no_std` without a heap; the `alloc` feature adds
-//! [`Recording`], which reads and writes both formats.
+//! `Recording`, which reads and writes both formats.
 #![no_std]
 #![deny(missing_docs)]
 #![deny(

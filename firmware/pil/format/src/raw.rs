@@ -1,5 +1,5 @@
 //! The raw format (magic `PIL1`): what `pil_record` writes and the PIL image embeds and reads.
-//! [`Reader`] needs no heap; [`crate::Recording`] (feature `alloc`) reads and writes it whole.
+//! [`Reader`] needs no heap; `Recording` (feature `alloc`) reads and writes it whole.
 
 use crate::cursor::Cursor;
 use crate::{Error, Header};
