@@ -1,30 +1,25 @@
-//! Links the image with the AN386 linker script that `cargo xtask pil` generates (its path in
-//! `PIL_LINK_X`), for the MCU target only. Not cortex-m-rt's `link.x`: that includes
-//! `memory.x`, and the linker would find the board's, in the workspace root, first.
-
-use std::path::PathBuf;
+//! For the MCU target only: links the image with its own linker script, `an386.x` beside this
+//! file (the memory map of QEMU's mps2-an386 and the sections cortex-m-rt's start-up code
+//! expects), and checks that the input file is given (`PIL_INPUTS`, which `cargo xtask pil`
+//! writes). Not cortex-m-rt's `link.x`: that includes `memory.x`, and the linker would find the
+//! board's, in the workspace root, first.
 
 fn main() {
     println!("cargo:rerun-if-changed=build.rs");
-    println!("cargo:rerun-if-env-changed=PIL_LINK_X");
+    println!("cargo:rerun-if-changed=an386.x");
     println!("cargo:rerun-if-env-changed=PIL_INPUTS");
     if std::env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
         return;
     }
-    let Some(script) = std::env::var_os("PIL_LINK_X").map(PathBuf::from) else {
-        println!(
-            "cargo:warning=firmware-pil is built by `cargo xtask pil` (it sets PIL_LINK_X and \
-             PIL_INPUTS)"
-        );
-        std::process::exit(1);
-    };
-    let out = PathBuf::from(std::env::var_os("OUT_DIR").unwrap_or_default());
-    if let Err(e) = std::fs::copy(&script, out.join("pil.x")) {
-        println!("cargo:warning=cannot copy {}: {e}", script.display());
+    if std::env::var_os("PIL_INPUTS").is_none() {
+        println!("cargo:warning=firmware-pil is built by `cargo xtask pil` (it sets PIL_INPUTS)");
         std::process::exit(1);
     }
-    println!("cargo:rerun-if-changed={}", script.display());
-    println!("cargo:rustc-link-search={}", out.display());
+    let Ok(dir) = std::env::var("CARGO_MANIFEST_DIR") else {
+        println!("cargo:warning=no CARGO_MANIFEST_DIR");
+        std::process::exit(1);
+    };
+    println!("cargo:rustc-link-search={dir}");
     println!("cargo:rustc-link-arg-bins=--nmagic");
-    println!("cargo:rustc-link-arg-bins=-Tpil.x");
+    println!("cargo:rustc-link-arg-bins=-Tan386.x");
 }

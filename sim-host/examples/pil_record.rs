@@ -7,9 +7,7 @@
 //! is written down with the tick it belongs to. The plan: stand, trot forward (L), then W —
 //! which folds the legs, catches the robot on its wheels and drives off balancing.
 //!
-//! Output (the "raw" format the PIL image reads): `PIL1`, control rate u16, first tick u32,
-//! tick count u32, then per tick: frame count u8 and per frame id u16, length u8, data. All
-//! little-endian.
+//! Output: `pil-format`'s raw format (the one the PIL image reads).
 //!
 //! ```sh
 //! cargo run --release -p sim-host --example pil_record -- OUT.raw [SECONDS]
@@ -17,10 +15,13 @@
 
 use std::time::Duration;
 
+use firmware::node::service::{self, Drain};
 use firmware::node::Node;
 use firmware::time::Tick;
-use host_can::bus::Bus;
+use host_can::bus::{Bus, BusError};
 use host_can::inproc_bus::InprocBus;
+use host_can::port::{BusPort, Wait};
+use pil_format::Recording;
 use protocol::TeleopMode;
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
@@ -71,16 +72,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             teleop_bus.send(&frame)?;
         }
         let now = Tick(cycle);
-        let mut received = Vec::new();
-        while let Some(frame) = controller_bus.recv(Duration::ZERO)? {
-            received.push((frame.id(), frame.data().to_vec()));
-            let _ = node.on_frame(now, frame.id(), frame.data());
-        }
-        let (output, frames) = node.poll(now);
-        modes.push(output.status.mode);
-        for frame in &frames {
-            controller_bus.send(frame)?;
-        }
+        // The firmware's own service loop, on a port that writes down what it hands over.
+        let mut recording = Recorded {
+            bus: &mut controller_bus,
+            received: Vec::new(),
+        };
+        let mut port = BusPort::new(&mut recording, Wait::Never);
+        service::receive(&mut node, now, &mut port, Drain::All, u32::MAX)?;
+        let sent = service::transmit(&mut node, now, &mut port)?;
+        modes.push(sent.output.status.mode);
+        let received = recording.received;
         ticks.push(received);
         Ok(())
     };
@@ -96,19 +97,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         peers,
         |_, _| true,
     )?;
-    let mut bytes = Vec::new();
-    bytes.extend_from_slice(b"PIL1");
-    bytes.extend_from_slice(&u16::try_from(CONTROL_HZ)?.to_le_bytes());
-    bytes.extend_from_slice(&0_u32.to_le_bytes());
-    bytes.extend_from_slice(&u32::try_from(ticks.len())?.to_le_bytes());
-    for frames in &ticks {
-        bytes.push(u8::try_from(frames.len())?);
-        for (id, data) in frames {
-            bytes.extend_from_slice(&id.to_le_bytes());
-            bytes.push(u8::try_from(data.len())?);
-            bytes.extend_from_slice(data);
-        }
-    }
+    let recording = Recording {
+        control_hz: u16::try_from(CONTROL_HZ)?,
+        first_tick: 0,
+        ticks,
+    };
+    let bytes = recording.to_raw()?;
     std::fs::write(&out, &bytes)?;
     // Where the controller's mode changed, to show what the recording covers.
     let mut changes = String::new();
@@ -124,10 +118,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     eprintln!(
         "pil_record: {} ticks, {} frames, {} bytes raw, missed cycles {}; modes:{changes}",
-        ticks.len(),
-        ticks.iter().map(Vec::len).sum::<usize>(),
+        recording.ticks.len(),
+        recording.ticks.iter().map(Vec::len).sum::<usize>(),
         bytes.len(),
         stats.missed_cycles
     );
     Ok(())
+}
+
+/// The controller's bus connection, writing down every frame it receives.
+struct Recorded<'a, B: Bus> {
+    bus: &'a mut B,
+    received: Vec<(u16, Vec<u8>)>,
+}
+
+impl<B: Bus> Bus for Recorded<'_, B> {
+    fn send(&mut self, frame: &protocol::Frame) -> Result<(), BusError> {
+        self.bus.send(frame)
+    }
+
+    fn recv(&mut self, timeout: Duration) -> Result<Option<protocol::Frame>, BusError> {
+        let frame = self.bus.recv(timeout)?;
+        if let Some(frame) = &frame {
+            self.received.push((frame.id(), frame.data().to_vec()));
+        }
+        Ok(frame)
+    }
+
+    fn name(&self) -> &str {
+        self.bus.name()
+    }
 }

@@ -1,9 +1,9 @@
-//! The recorded inputs (the "raw" format `cargo xtask pil` writes): `PIL1`, control rate u16,
-//! first tick u32, tick count u32, then per tick a frame count u8 and per frame id u16,
-//! length u8, data; little-endian.
+//! The recorded inputs: `pil-format`'s raw format (`cargo xtask pil` writes it), read tick by
+//! tick into CAN frames.
 
+use embedded_can::{Frame, StandardId};
 use heapless::Vec;
-use protocol::Frame;
+use pil_format::raw::Reader;
 
 /// Most frames one tick may carry.
 pub const MAX_FRAMES: usize = 24;
@@ -16,61 +16,29 @@ pub struct Inputs {
     pub first_tick: u32,
     /// Ticks recorded.
     pub ticks: u32,
-    cursor: Cursor,
+    reader: Reader<'static>,
 }
 
 impl Inputs {
     /// `None` unless `bytes` starts with a valid header.
     pub fn parse(bytes: &'static [u8]) -> Option<Self> {
-        let mut cursor = Cursor { bytes, pos: 0 };
-        if cursor.take(4)? != b"PIL1" {
-            return None;
-        }
+        let reader = Reader::new(bytes).ok()?;
+        let header = reader.header();
         Some(Self {
-            control_hz: u32::from(cursor.u16()?),
-            first_tick: cursor.u32()?,
-            ticks: cursor.u32()?,
-            cursor,
+            control_hz: u32::from(header.control_hz),
+            first_tick: header.first_tick,
+            ticks: header.ticks,
+            reader,
         })
     }
 
-    /// The next tick's frames into `frames` (cleared first); `None` at the end or on a
-    /// malformed record.
-    pub fn next_tick(&mut self, frames: &mut Vec<Frame, MAX_FRAMES>) -> Option<()> {
+    /// The next tick's frames into `frames` (cleared first); `None` at the end, on a malformed
+    /// record, or on a frame that is not a standard-id CAN (FD) frame or does not fit.
+    pub fn next_tick<F: Frame>(&mut self, frames: &mut Vec<F, MAX_FRAMES>) -> Option<()> {
         frames.clear();
-        let count = self.cursor.u8()?;
-        for _ in 0..count {
-            let id = self.cursor.u16()?;
-            let len = usize::from(self.cursor.u8()?);
-            let frame = Frame::new(id, self.cursor.take(len)?)?;
-            frames.push(frame).ok()?;
+        for (id, data) in self.reader.next_tick().ok()?? {
+            frames.push(F::new(StandardId::new(id)?, data)?).ok()?;
         }
         Some(())
-    }
-}
-
-struct Cursor {
-    bytes: &'static [u8],
-    pos: usize,
-}
-
-impl Cursor {
-    fn take(&mut self, n: usize) -> Option<&'static [u8]> {
-        let end = self.pos.checked_add(n)?;
-        let out = self.bytes.get(self.pos..end)?;
-        self.pos = end;
-        Some(out)
-    }
-
-    fn u8(&mut self) -> Option<u8> {
-        self.take(1)?.first().copied()
-    }
-
-    fn u16(&mut self) -> Option<u16> {
-        Some(u16::from_le_bytes(self.take(2)?.try_into().ok()?))
-    }
-
-    fn u32(&mut self) -> Option<u32> {
-        Some(u32::from_le_bytes(self.take(4)?.try_into().ok()?))
     }
 }

@@ -1,13 +1,14 @@
 //! Processor-in-the-loop: the control core on an emulated Cortex-M4F (QEMU `mps2-an386`),
 //! stepped through recorded bus traffic, reporting what it sends and what each step cost.
 //!
-//! `cargo xtask pil` generates this image's linker script and memory map (the AN386's 4 MiB ZBT
-//! SSRAM1 at 0x0000_0000 for code, 128 KiB — the STM32G474's RAM size — of ZBT SSRAM2/3 at
-//! 0x2000_0000 for data and stack), turns the committed recording into the input file embedded here
-//! (`PIL_INPUTS`), builds, runs QEMU with `-icount shift=0` and compares the frames with the
-//! host build's. Each tick the firmware's one service loop ([`firmware::node::service`], as on
-//! the board) gives the [`firmware::Node`] the frames recorded for it and runs the tick, through
-//! a port over the recording; the image times both with SysTick, then prints (semihosting):
+//! The image links with its own linker script, `an386.x`: the AN386's 4 MiB ZBT SSRAM1 at
+//! 0x0000_0000 for code, 128 KiB — the STM32G474's RAM size — of ZBT SSRAM2/3 at 0x2000_0000
+//! for data and stack. `cargo xtask pil` turns the committed recording into the input file
+//! embedded here (`PIL_INPUTS`, in `pil-format`'s raw format), builds, runs QEMU with
+//! `-icount shift=0` and compares the frames with the host build's. Each tick the firmware's
+//! one service loop ([`firmware::node::service`], as on the board) gives the
+//! [`firmware::Node`] the frames recorded for it and runs the tick, through a port over the
+//! recording; the image times both with SysTick, then prints (semihosting):
 //!
 //! ```text
 //! PIL-CAL <instructions> <systick ticks>   a calibration loop of known length
