@@ -52,16 +52,16 @@ fn the_gait_after_ten_hours_is_the_gait_after_ten_seconds() {
 #[test]
 fn stepping_ten_hours_tick_by_tick_lands_exactly_on_the_ideal_phase() {
     // 1 Hz and an awkward 1.3 Hz at 250 Hz: the Bresenham remainder keeps the phase exact.
-    for frequency_mhz in [1000, 1300] {
-        let step = PhaseStep::new(frequency_mhz, TickRate::SIM_250_HZ).unwrap();
+    for frequency_millihz in [1000, 1300] {
+        let step = PhaseStep::new(frequency_millihz, TickRate::SIM_250_HZ).unwrap();
         let mut phase = Phase::default();
         for _ in 0..TEN_HOURS {
             phase.advance(step);
         }
         assert_eq!(phase, Phase::after(step, TEN_HOURS));
-        let ideal = (TEN_HOURS as u128 * frequency_mhz as u128 * (1u128 << 32) / (250 * 1000))
+        let ideal = (TEN_HOURS as u128 * frequency_millihz as u128 * (1u128 << 32) / (250 * 1000))
             % (1u128 << 32);
-        assert_eq!(phase.count() as u128, ideal, "{frequency_mhz} mHz");
+        assert_eq!(phase.count() as u128, ideal, "{frequency_millihz} mHz");
     }
     // What the integer phase avoids: the report's float time `t += dt` after ten hours.
     let mut t = 0.0f32;

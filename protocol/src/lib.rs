@@ -43,6 +43,8 @@
 //! let accepted = rx.receive(frame.id(), frame.data()).unwrap();
 //! assert_eq!(accepted.message, AnyMessage::TeleopCommand(command));
 //! ```
+// Functions stay short enough to read whole (clippy.toml: 80 lines); tests may run longer.
+#![cfg_attr(not(test), warn(clippy::too_many_lines))]
 #![cfg_attr(not(test), no_std)]
 #![deny(
     missing_docs,

@@ -121,34 +121,6 @@ wire_enum!(
     }
 );
 
-impl TeleopMode {
-    /// The report's key for this mode, if it has one.
-    pub const fn key(self) -> Option<char> {
-        match self {
-            TeleopMode::Stop => Some('X'),
-            TeleopMode::WheelForward => Some('W'),
-            TeleopMode::WheelBackward => Some('S'),
-            TeleopMode::WheelRotate => Some('A'),
-            TeleopMode::TrotForward => Some('L'),
-            TeleopMode::TrotBackward => Some('K'),
-            TeleopMode::Stand | TeleopMode::Fold => None,
-        }
-    }
-
-    /// The mode of one of the report's keys (either case), or `None` for any other key.
-    pub const fn from_key(key: char) -> Option<Self> {
-        Some(match key.to_ascii_uppercase() {
-            'X' => TeleopMode::Stop,
-            'W' => TeleopMode::WheelForward,
-            'S' => TeleopMode::WheelBackward,
-            'A' => TeleopMode::WheelRotate,
-            'L' => TeleopMode::TrotForward,
-            'K' => TeleopMode::TrotBackward,
-            _ => return None,
-        })
-    }
-}
-
 wire_enum!(
     /// State of the controller's mode machine, as reported in its status.
     ControllerMode {

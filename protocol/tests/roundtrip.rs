@@ -72,20 +72,3 @@ fn estop_has_the_highest_priority_then_sync_then_commands() {
     assert!(MessageId::TeleopHeartbeat.raw() < MessageId::ControllerStatus.raw());
     assert!(MessageId::DriveStatus(Drive::Wheel).raw() < MessageId::RejectCounters.raw());
 }
-
-#[test]
-fn teleop_keys_are_the_reports() {
-    for (key, mode) in [
-        ('W', TeleopMode::WheelForward),
-        ('S', TeleopMode::WheelBackward),
-        ('A', TeleopMode::WheelRotate),
-        ('L', TeleopMode::TrotForward),
-        ('K', TeleopMode::TrotBackward),
-        ('X', TeleopMode::Stop),
-    ] {
-        assert_eq!(TeleopMode::from_key(key), Some(mode));
-        assert_eq!(TeleopMode::from_key(key.to_ascii_lowercase()), Some(mode));
-        assert_eq!(mode.key(), Some(key));
-    }
-    assert_eq!(TeleopMode::from_key('Q'), None);
-}

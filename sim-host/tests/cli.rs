@@ -17,7 +17,7 @@ fn scratch(name: &str) -> PathBuf {
 fn a_run_leaves_telemetry_a_candump_log_and_plots() {
     let out = scratch("run");
     let result = sim_host()
-        .args(["run", "--duration", "2", "--drive", "0:X", "--out"])
+        .args(["run", "--duration-s", "2", "--drive", "0:X", "--out"])
         .arg(&out)
         .output()
         .unwrap();
@@ -57,7 +57,7 @@ fn a_run_leaves_telemetry_a_candump_log_and_plots() {
 #[test]
 fn a_missing_can_interface_names_the_commands_that_create_it() {
     let result = sim_host()
-        .args(["run", "--bus", "vcan-absent9", "--duration", "1", "--out"])
+        .args(["run", "--bus", "vcan-absent9", "--duration-s", "1", "--out"])
         .arg(scratch("novcan"))
         .output()
         .unwrap();
@@ -87,7 +87,7 @@ fn a_broken_model_names_the_file() {
     let model = dir.join("robot.xml");
     std::fs::write(&model, "<mujoco><worldbody><body></mujoco>").unwrap();
     let result = sim_host()
-        .args(["run", "--duration", "1", "--model"])
+        .args(["run", "--duration-s", "1", "--model"])
         .arg(&model)
         .arg("--out")
         .arg(dir.join("out"))
@@ -99,25 +99,25 @@ fn a_broken_model_names_the_file() {
 }
 
 #[test]
-fn real_time_mode_runs_on_the_wall_clock_and_reports_it() {
-    let started = std::time::Instant::now();
-    let result = sim_host()
-        .args([
-            "run",
-            "--mode",
-            "realtime",
-            "--duration",
-            "1",
-            "--no-plots",
-            "--out",
-        ])
-        .arg(scratch("realtime"))
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&result.stdout);
-    assert!(result.status.success(), "{stdout}");
-    assert!(stdout.contains("cycles           250 ("), "{stdout}");
-    assert!(stdout.contains("x real time"), "{stdout}");
-    // One simulated second takes at least one wall second (it may take longer on a busy machine).
-    assert!(started.elapsed() >= std::time::Duration::from_millis(990));
+fn the_wall_clock_runs_in_real_time_and_reports_it() {
+    // The new flags, then the old names they replace (kept as aliases for one release).
+    for (name, args) in [
+        ("wall", ["--clock", "wall", "--duration-s", "1"]),
+        ("realtime", ["--mode", "realtime", "--duration", "1"]),
+    ] {
+        let started = std::time::Instant::now();
+        let result = sim_host()
+            .arg("run")
+            .args(args)
+            .args(["--no-plots", "--out"])
+            .arg(scratch(name))
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&result.stdout);
+        assert!(result.status.success(), "{name}: {stdout}");
+        assert!(stdout.contains("cycles           250 ("), "{stdout}");
+        assert!(stdout.contains("x real time"), "{stdout}");
+        // One simulated second takes at least one wall second (longer on a busy machine).
+        assert!(started.elapsed() >= std::time::Duration::from_millis(990));
+    }
 }

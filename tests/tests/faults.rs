@@ -223,10 +223,17 @@ fn a_10000_frames_per_second_teleop_flood_leaves_the_control_period_and_feedback
     std::thread::sleep(Duration::from_millis(200));
     let fw = Process::start(
         "firmware-host",
-        &["--bus", bus.name(), "--clock", "timer", "--rate-hz", "250"],
+        &[
+            "--bus",
+            bus.name(),
+            "--clock",
+            "wall",
+            "--control-hz",
+            "250",
+        ],
     );
     let out = out_dir("faults-flood-run");
-    let sim = start_sim(bus.name(), &out, &["--mode", "realtime", "--duration", "5"]);
+    let sim = start_sim(bus.name(), &out, &["--clock", "wall", "--duration-s", "5"]);
     std::thread::sleep(Duration::from_millis(1000));
     let flood_s = 3.0;
     let flood_start = Instant::now();
@@ -357,7 +364,7 @@ fn a_killed_firmware_leaves_the_drives_torque_free_within_100_ms_and_they_say_ti
         bus.name(),
         &out,
         &[
-            "--duration",
+            "--duration-s",
             "6",
             "--drive",
             "0:fold",

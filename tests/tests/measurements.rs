@@ -46,7 +46,7 @@ fn the_bus_load_candump_sees_matches_the_computed_schedule() {
     std::thread::sleep(Duration::from_millis(200));
     let fw = firmware(&bus);
     let out = out_dir("load-run");
-    let status = start_sim(bus.name(), &out, &["--duration", "4", "--drive", "0:L"])
+    let status = start_sim(bus.name(), &out, &["--duration-s", "4", "--drive", "0:L"])
         .wait(Duration::from_secs(600));
     assert!(status.success());
     std::thread::sleep(Duration::from_millis(300));
@@ -91,10 +91,17 @@ fn real_time_control_period_jitter_and_feedback_to_command_latency() {
     std::thread::sleep(Duration::from_millis(200));
     let fw = Process::start(
         "firmware-host",
-        &["--bus", bus.name(), "--clock", "timer", "--rate-hz", "250"],
+        &[
+            "--bus",
+            bus.name(),
+            "--clock",
+            "wall",
+            "--control-hz",
+            "250",
+        ],
     );
     let out = out_dir("jitter-run");
-    let status = start_sim(bus.name(), &out, &["--mode", "realtime", "--duration", "3"])
+    let status = start_sim(bus.name(), &out, &["--clock", "wall", "--duration-s", "3"])
         .wait(Duration::from_secs(600));
     assert!(status.success());
     let _ = fw.terminate();

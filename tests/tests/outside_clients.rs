@@ -19,7 +19,7 @@ fn an_e_stop_from_cansend_stops_every_drive_within_one_control_period() {
     let sim = start_sim(
         bus.name(),
         &out,
-        &["--duration", "12", "--drive", "0:fold", "--drive", "3:W"],
+        &["--duration-s", "12", "--drive", "0:fold", "--drive", "3:W"],
     );
     // Wait until the controller reports driving forward, then press the E-stop from a shell.
     let driving = wait_for_log(&log, Duration::from_secs(300), |frames| {
@@ -87,7 +87,7 @@ fn candump_records_a_bus_on_which_every_frame_decodes() {
     let dump = candump(&bus, &log);
     std::thread::sleep(Duration::from_millis(200));
     let out = out_dir("dump-run");
-    let sim = start_sim(bus.name(), &out, &["--duration", "3", "--drive", "0:W"]);
+    let sim = start_sim(bus.name(), &out, &["--duration-s", "3", "--drive", "0:W"]);
     assert!(sim.wait(Duration::from_secs(600)).success());
     std::thread::sleep(Duration::from_millis(300));
     let _ = fw.terminate();
@@ -153,7 +153,7 @@ fn candump_records_a_bus_on_which_every_frame_decodes() {
 /// only where the simulator keeps up with the wall clock, which an emulated VM does not.)
 fn lockstep_pair(bus: &Vcan, out: &std::path::Path, extra: &[&str]) -> (Process, Process) {
     let fw = firmware(bus);
-    let mut args = vec!["--duration", "8"];
+    let mut args = vec!["--duration-s", "8"];
     args.extend_from_slice(extra);
     let sim = start_sim(bus.name(), out, &args);
     (fw, sim)
@@ -237,7 +237,7 @@ impl PacedRobot {
         let log = out_dir(&format!("{name}-dump")).with_extension("log");
         let dump = candump(&bus, &log);
         let out = out_dir(name);
-        let sim = start_sim(bus.name(), &out, &["--duration", seconds, "--pace", "1"]);
+        let sim = start_sim(bus.name(), &out, &["--duration-s", seconds, "--pace", "1"]);
         let up = wait_for_log(&log, Duration::from_secs(120), |frames| {
             frames.iter().any(|(_, f)| f.id() == 0x400)
         });

@@ -3,7 +3,7 @@
 //!
 //! - **lockstep**: the simulator sends each cycle's feedback and then `SYNC(tick)`; on `SYNC`
 //!   the runner computes that tick and answers with its commands. Nothing else paces it.
-//! - **timer**: the runner keeps its own time at the control rate, as on the MCU, taking
+//! - **wall**: the runner keeps its own time at the control rate, as on the MCU, taking
 //!   whatever arrived since the last tick.
 //!
 //! On a stop request (SIGINT/SIGTERM in the binary) it sends the drives a last command — zero
@@ -34,8 +34,8 @@ const LOCKSTEP_POLL: Duration = Duration::from_millis(50);
 pub enum Clock {
     /// Compute one tick per `SYNC` frame.
     Lockstep,
-    /// Compute on the wall clock at the control rate.
-    Timer,
+    /// Compute on the wall clock at the control rate, as on the microcontroller.
+    Wall,
 }
 
 /// Runner settings.
@@ -63,7 +63,7 @@ pub struct RunnerStats {
     /// Frames the firmware rejected, by cause, in [`RejectCause::ALL`] order (unknown id, wrong
     /// length, CRC, out of range, repeated, wrong sequence, rate limited).
     pub rejected: [u64; RejectCause::ALL.len()],
-    /// Timer mode: ticks lost because the runner woke in a later period than the one they were
+    /// Wall clock: ticks lost because the runner woke in a later period than the one they were
     /// due in (the tick counter then runs slow, as on the MCU, instead of catching up in a burst).
     pub overruns: u64,
 }
@@ -97,7 +97,7 @@ pub fn run(
     let mut stats = RunnerStats::default();
     let result = match config.clock {
         Clock::Lockstep => lockstep(bus, &mut node, config, stop, &mut stats),
-        Clock::Timer => timer(bus, &mut node, rate, config, stop, &mut stats),
+        Clock::Wall => wall(bus, &mut node, rate, config, stop, &mut stats),
     };
     stats.rejected = node.reject_counters().rejected.map(|n| u64::from(n.raw()));
     send_stop(bus, &mut node, &mut stats)?;
@@ -140,7 +140,7 @@ fn lockstep(
     Ok(())
 }
 
-fn timer(
+fn wall(
     bus: &mut dyn Bus,
     node: &mut Node,
     rate: TickRate,

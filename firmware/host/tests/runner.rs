@@ -97,7 +97,7 @@ fn timer_mode_keeps_its_own_time() {
     let stats = runner::run(
         &mut firmware_bus,
         RunnerConfig {
-            clock: Clock::Timer,
+            clock: Clock::Wall,
             control_hz: 250,
             max_ticks: Some(25),
             idle_timeout: None,
@@ -159,7 +159,7 @@ fn a_stalled_timer_loses_the_missed_ticks_instead_of_bunching_them_up() {
     let stats = runner::run(
         &mut stalling,
         RunnerConfig {
-            clock: Clock::Timer,
+            clock: Clock::Wall,
             control_hz: 250,
             max_ticks: Some(20),
             idle_timeout: None,

@@ -29,7 +29,7 @@ pub enum Generator {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TrotParams {
     /// Stride frequency, mHz (the report's 1 Hz = 1000).
-    pub frequency_mhz: u32,
+    pub frequency_millihz: u32,
     /// Foot-motion generator.
     pub generator: Generator,
 }
@@ -37,12 +37,12 @@ pub struct TrotParams {
 impl TrotParams {
     /// The default walking gait: 1 Hz, Cartesian foot path.
     pub const DEFAULT: Self = Self {
-        frequency_mhz: 1000,
+        frequency_millihz: 1000,
         generator: Generator::Cartesian(FootTrajectory::DEFAULT),
     };
     /// The report's gait: 1 Hz joint-space sinusoids.
     pub const REPORT: Self = Self {
-        frequency_mhz: 1000,
+        frequency_millihz: 1000,
         generator: Generator::Sine(SineGait::REPORT),
     };
 }
@@ -66,7 +66,7 @@ pub struct Trot {
 impl Trot {
     /// `None` if the frequency is zero or not below the tick rate.
     pub const fn new(params: TrotParams, rate: TickRate) -> Option<Self> {
-        match PhaseStep::new(params.frequency_mhz, rate) {
+        match PhaseStep::new(params.frequency_millihz, rate) {
             Some(step) => Some(Self {
                 params,
                 step,

@@ -19,14 +19,14 @@ pub struct PhaseStep {
 }
 
 impl PhaseStep {
-    /// The step for a cycle of `frequency_mhz` millihertz at `rate`. `None` if the frequency is
+    /// The step for a cycle of `frequency_millihz` millihertz at `rate`. `None` if the frequency is
     /// zero or not below the tick rate (the phase would alias).
-    pub const fn new(frequency_mhz: u32, rate: TickRate) -> Option<Self> {
+    pub const fn new(frequency_millihz: u32, rate: TickRate) -> Option<Self> {
         let denominator = rate.hz() as u64 * 1000;
-        if frequency_mhz == 0 || frequency_mhz as u64 >= denominator {
+        if frequency_millihz == 0 || frequency_millihz as u64 >= denominator {
             return None;
         }
-        let counts = frequency_mhz as u64 * COUNTS_PER_CYCLE;
+        let counts = frequency_millihz as u64 * COUNTS_PER_CYCLE;
         let whole = counts / denominator;
         let numerator = counts % denominator;
         if whole > u32::MAX as u64 || denominator > u32::MAX as u64 {

@@ -2,5 +2,7 @@
 //! connection and the means to kill or restart a peer) and the [`matrix`] of fault cells it
 //! runs, each judged.
 
+mod cells;
+mod judge;
 pub mod matrix;
 pub mod rig;

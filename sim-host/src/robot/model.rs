@@ -154,25 +154,8 @@ impl Layout {
             layout.foot_touch[leg] = sensor(&format!("touch_{suffix}"))?;
             layout.foot_geoms[leg] = geom(&format!("foot_{suffix}"))?;
         }
+        layout.check_leg_groups(model, path)?;
         let groups = model.actuator_group();
-        for (i, name) in JOINT_NAMES.iter().enumerate() {
-            let group = groups[layout.leg_actuator[i]];
-            if group as u32 != layout.leg_group[i / 4] || !(0..=30).contains(&group) {
-                return Err(ModelError::ActuatorGroups {
-                    path: path.to_owned(),
-                    detail: format!("m_{name} is in group {group}"),
-                });
-            }
-        }
-        let mut distinct = layout.leg_group.to_vec();
-        distinct.sort_unstable();
-        distinct.dedup();
-        if distinct.len() != 4 {
-            return Err(ModelError::ActuatorGroups {
-                path: path.to_owned(),
-                detail: format!("leg groups {:?} are not distinct", layout.leg_group),
-            });
-        }
         for (i, side) in WHEEL_NAMES.iter().enumerate() {
             let j = joint(&format!("wheel_{side}_joint"))?;
             layout.wheel_qpos[i] = qpos(j);
@@ -188,6 +171,31 @@ impl Layout {
             }
         }
         Ok(layout)
+    }
+
+    /// Each leg's actuators in one group of its own (0…30), so that a leg can go torque-free
+    /// by disabling its group.
+    fn check_leg_groups(&self, model: &MjModel, path: &Path) -> Result<(), ModelError> {
+        let groups = model.actuator_group();
+        for (i, name) in JOINT_NAMES.iter().enumerate() {
+            let group = groups[self.leg_actuator[i]];
+            if group as u32 != self.leg_group[i / 4] || !(0..=30).contains(&group) {
+                return Err(ModelError::ActuatorGroups {
+                    path: path.to_owned(),
+                    detail: format!("m_{name} is in group {group}"),
+                });
+            }
+        }
+        let mut distinct = self.leg_group.to_vec();
+        distinct.sort_unstable();
+        distinct.dedup();
+        if distinct.len() != 4 {
+            return Err(ModelError::ActuatorGroups {
+                path: path.to_owned(),
+                detail: format!("leg groups {:?} are not distinct", self.leg_group),
+            });
+        }
+        Ok(())
     }
 }
 

@@ -44,6 +44,33 @@ pub enum Action {
     Quit,
 }
 
+/// The report's key for `mode`, if it has one (stand and fold have none: `T` and `F` are this
+/// program's).
+pub const fn mode_key(mode: TeleopMode) -> Option<char> {
+    match mode {
+        TeleopMode::Stop => Some('X'),
+        TeleopMode::WheelForward => Some('W'),
+        TeleopMode::WheelBackward => Some('S'),
+        TeleopMode::WheelRotate => Some('A'),
+        TeleopMode::TrotForward => Some('L'),
+        TeleopMode::TrotBackward => Some('K'),
+        TeleopMode::Stand | TeleopMode::Fold => None,
+    }
+}
+
+/// The mode of one of the report's keys (either case), or `None` for any other key.
+pub const fn mode_of_key(key: char) -> Option<TeleopMode> {
+    Some(match key.to_ascii_uppercase() {
+        'X' => TeleopMode::Stop,
+        'W' => TeleopMode::WheelForward,
+        'S' => TeleopMode::WheelBackward,
+        'A' => TeleopMode::WheelRotate,
+        'L' => TeleopMode::TrotForward,
+        'K' => TeleopMode::TrotBackward,
+        _ => return None,
+    })
+}
+
 /// The action of `key`, `None` for a key with no meaning.
 pub fn action(key: Key) -> Option<Action> {
     Some(match key {
@@ -58,7 +85,7 @@ pub fn action(key: Key) -> Option<Action> {
             '[' => Action::Speed(-10.0),
             'R' => Action::Release,
             'Q' => Action::Quit,
-            other => Action::Mode(TeleopMode::from_key(other)?),
+            other => Action::Mode(mode_of_key(other)?),
         },
     })
 }
@@ -66,6 +93,24 @@ pub fn action(key: Key) -> Option<Action> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_reports_keys_name_its_modes_both_ways() {
+        for (key, mode) in [
+            ('W', TeleopMode::WheelForward),
+            ('S', TeleopMode::WheelBackward),
+            ('A', TeleopMode::WheelRotate),
+            ('L', TeleopMode::TrotForward),
+            ('K', TeleopMode::TrotBackward),
+            ('X', TeleopMode::Stop),
+        ] {
+            assert_eq!(mode_of_key(key), Some(mode));
+            assert_eq!(mode_of_key(key.to_ascii_lowercase()), Some(mode));
+            assert_eq!(mode_key(mode), Some(key));
+        }
+        assert_eq!(mode_of_key('Q'), None);
+        assert_eq!(mode_key(TeleopMode::Stand), None);
+    }
 
     #[test]
     fn the_reports_keys_and_the_others() {

@@ -23,6 +23,7 @@ use protocol::TeleopMode;
 use serde::Deserialize;
 use toml::Spanned;
 
+use crate::keys::{mode_key, mode_of_key};
 use crate::scripted::PlanStep;
 
 /// One operator command and the segment it starts.
@@ -106,7 +107,7 @@ pub fn parse_mode(text: &str) -> Option<TeleopMode> {
         key => {
             let mut chars = key.chars();
             match (chars.next(), chars.next()) {
-                (Some(c), None) => TeleopMode::from_key(c),
+                (Some(c), None) => mode_of_key(c),
                 _ => None,
             }
         }
@@ -118,7 +119,7 @@ pub fn mode_name(mode: TeleopMode) -> String {
     match mode {
         TeleopMode::Stand => "stand".into(),
         TeleopMode::Fold => "fold".into(),
-        other => other.key().map(String::from).unwrap_or_default(),
+        other => mode_key(other).map(String::from).unwrap_or_default(),
     }
 }
 
@@ -134,93 +135,27 @@ impl Scenario {
 
     /// Parses `text` (named `path` in errors).
     pub fn parse(path: &Path, text: &str) -> Result<Self, ScenarioError> {
-        let line_of = |offset: usize| {
-            text.get(..offset).map_or(1, |s| {
-                s.lines().count().max(1) + usize::from(s.ends_with('\n'))
-            })
-        };
+        let source = Source { path, text };
         let raw: RawScenario = toml::from_str(text).map_err(|e| ScenarioError::Syntax {
             path: path.to_owned(),
-            line: e.span().map_or(1, |span| line_of(span.start)),
+            line: e.span().map_or(1, |span| source.line_of(span.start)),
             message: e.message().trim().to_owned(),
         })?;
-        let value_error = |offset: usize, message: String| ScenarioError::Value {
-            path: path.to_owned(),
-            line: line_of(offset),
-            message,
-        };
         let duration_s = *raw.duration_s.get_ref();
         if !(duration_s.is_finite() && duration_s > 0.0 && duration_s <= 86_400.0) {
-            return Err(value_error(
+            return Err(source.value_error(
                 raw.duration_s.span().start,
                 format!("duration_s = {duration_s}: give 0 < duration_s ≤ 86400 s"),
             ));
         }
         if raw.step.is_empty() {
-            return Err(value_error(
-                0,
-                "no [[step]]: give at least one command".into(),
-            ));
+            return Err(source.value_error(0, "no [[step]]: give at least one command".into()));
         }
         let mut steps = Vec::with_capacity(raw.step.len());
-        let mut previous_s = -1.0;
+        let mut previous_s = None;
         for step in &raw.step {
-            let s = step.get_ref();
-            let at_s = *s.at_s.get_ref();
-            if !(at_s.is_finite() && at_s >= 0.0 && at_s < duration_s) {
-                return Err(value_error(
-                    s.at_s.span().start,
-                    format!("at_s = {at_s}: steps start at 0 ≤ at_s < duration_s ({duration_s} s)"),
-                ));
-            }
-            if at_s <= previous_s {
-                return Err(value_error(
-                    s.at_s.span().start,
-                    format!("at_s = {at_s} is not after the previous step's {previous_s} s"),
-                ));
-            }
-            previous_s = at_s;
-            let mode = parse_mode(s.mode.get_ref()).ok_or_else(|| {
-                value_error(
-                    s.mode.span().start,
-                    format!(
-                        "mode = \"{}\": use W, S, A, L, K, X, stand or fold",
-                        s.mode.get_ref()
-                    ),
-                )
-            })?;
-            let body_height_m = match &s.body_height_m {
-                Some(h) if !(-0.10..=0.12).contains(h.get_ref()) => {
-                    return Err(value_error(
-                        h.span().start,
-                        format!(
-                            "body_height_m = {}: the range is −0.10…+0.12 m",
-                            h.get_ref()
-                        ),
-                    ))
-                }
-                Some(h) => *h.get_ref(),
-                None => 0.0,
-            };
-            let speed_scale_pct = match &s.speed_scale_pct {
-                Some(v) if !(0.0..=100.0).contains(v.get_ref()) => {
-                    return Err(value_error(
-                        v.span().start,
-                        format!("speed_scale_pct = {}: the range is 0…100", v.get_ref()),
-                    ))
-                }
-                Some(v) => *v.get_ref(),
-                None => 100.0,
-            };
-            steps.push(Step {
-                plan: PlanStep {
-                    at_us: (at_s * 1e6).round() as u64,
-                    mode,
-                    body_height_m: body_height_m as f32,
-                    speed_scale_pct: speed_scale_pct as f32,
-                },
-                label: s.label.clone().unwrap_or_else(|| mode_name(mode)),
-            });
+            steps.push(source.step(step.get_ref(), duration_s, previous_s)?);
+            previous_s = Some(*step.get_ref().at_s.get_ref());
         }
         Ok(Self {
             name: raw.name.unwrap_or_else(|| {
@@ -235,6 +170,92 @@ impl Scenario {
     /// The operator's plan.
     pub fn plan(&self) -> Vec<PlanStep> {
         self.steps.iter().map(|s| s.plan).collect()
+    }
+}
+
+/// A scenario file's text, for errors that name its line.
+struct Source<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl Source<'_> {
+    /// The 1-based line of byte `offset`.
+    fn line_of(&self, offset: usize) -> usize {
+        self.text.get(..offset).map_or(1, |s| {
+            s.lines().count().max(1) + usize::from(s.ends_with('\n'))
+        })
+    }
+
+    fn value_error(&self, offset: usize, message: String) -> ScenarioError {
+        ScenarioError::Value {
+            path: self.path.to_owned(),
+            line: self.line_of(offset),
+            message,
+        }
+    }
+
+    /// One checked step; `previous_s` is the start of the step before, if any.
+    fn step(
+        &self,
+        s: &RawStep,
+        duration_s: f64,
+        previous_s: Option<f64>,
+    ) -> Result<Step, ScenarioError> {
+        let at_s = *s.at_s.get_ref();
+        if !(at_s.is_finite() && at_s >= 0.0 && at_s < duration_s) {
+            return Err(self.value_error(
+                s.at_s.span().start,
+                format!("at_s = {at_s}: steps start at 0 ≤ at_s < duration_s ({duration_s} s)"),
+            ));
+        }
+        if let Some(previous_s) = previous_s.filter(|&p| at_s <= p) {
+            return Err(self.value_error(
+                s.at_s.span().start,
+                format!("at_s = {at_s} is not after the previous step's {previous_s} s"),
+            ));
+        }
+        let mode = parse_mode(s.mode.get_ref()).ok_or_else(|| {
+            self.value_error(
+                s.mode.span().start,
+                format!(
+                    "mode = \"{}\": use W, S, A, L, K, X, stand or fold",
+                    s.mode.get_ref()
+                ),
+            )
+        })?;
+        let body_height_m = self.in_range(&s.body_height_m, -0.10..=0.12, 0.0, |v| {
+            format!("body_height_m = {v}: the range is −0.10…+0.12 m")
+        })?;
+        let speed_scale_pct = self.in_range(&s.speed_scale_pct, 0.0..=100.0, 100.0, |v| {
+            format!("speed_scale_pct = {v}: the range is 0…100")
+        })?;
+        Ok(Step {
+            plan: PlanStep {
+                at_us: (at_s * 1e6).round() as u64,
+                mode,
+                body_height_m: body_height_m as f32,
+                speed_scale_pct: speed_scale_pct as f32,
+            },
+            label: s.label.clone().unwrap_or_else(|| mode_name(mode)),
+        })
+    }
+
+    /// An optional value, `default` when absent, an error naming it when outside `range`.
+    fn in_range(
+        &self,
+        value: &Option<Spanned<f64>>,
+        range: std::ops::RangeInclusive<f64>,
+        default: f64,
+        message: impl Fn(f64) -> String,
+    ) -> Result<f64, ScenarioError> {
+        match value {
+            Some(v) if !range.contains(v.get_ref()) => {
+                Err(self.value_error(v.span().start, message(*v.get_ref())))
+            }
+            Some(v) => Ok(*v.get_ref()),
+            None => Ok(default),
+        }
     }
 }
 

@@ -17,6 +17,8 @@
 //!
 //! The core (header, errors, raw reader) is `no_std` without a heap; the `alloc` feature adds
 //! `Recording`, which reads and writes both formats.
+// Functions stay short enough to read whole (clippy.toml: 80 lines); tests may run longer.
+#![cfg_attr(not(test), warn(clippy::too_many_lines))]
 #![no_std]
 #![deny(missing_docs)]
 #![deny(

@@ -1,0 +1,246 @@
+//! `sim-host run`: its flags, and the session they describe.
+
+use std::num::NonZeroU32;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use clap::ValueEnum;
+use host_can::fault_plan::Faults;
+use sim_host::robot::imu::ImuNoise;
+use sim_host::robot::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
+use sim_host::session::{self, BusChoice, Clock, FrameSettings, SegmentSpec, SessionConfig};
+use teleop_core::scenario::{mode_name, Scenario};
+use teleop_core::scripted::PlanStep;
+
+/// What paces a run; the same names as `firmware-host --clock`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum ClockArg {
+    /// The simulator sends SYNC each cycle, waits for the controller, then steps:
+    /// deterministic, faster than real time.
+    Lockstep,
+    /// Steps on the wall clock at the control rate; reports real-time factor and overruns.
+    #[value(alias = "realtime")]
+    Wall,
+}
+
+impl ClockArg {
+    /// The name in `summary.json`.
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            ClockArg::Lockstep => "lockstep",
+            ClockArg::Wall => "wall",
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub(crate) enum Scene {
+    /// Flat ground.
+    Flat,
+    /// A 6 cm step at 1.5 m and a 10° ramp from 3 m.
+    Obstacles,
+}
+
+#[derive(Debug, clap::Args)]
+pub(crate) struct RunArgs {
+    /// `inproc` (the firmware runs in this process) or a SocketCAN interface such as `vcan0`.
+    #[arg(long, default_value = "inproc")]
+    pub(crate) bus: String,
+    /// What paces the run (`--mode` and `realtime` are the old names, kept for one release).
+    #[arg(long, value_enum, default_value = "lockstep", alias = "mode")]
+    pub(crate) clock: ClockArg,
+    /// Simulated seconds to run (default 10, or the scenario's `duration_s`; `--duration` is the
+    /// old name).
+    #[arg(long = "duration-s", alias = "duration")]
+    pub(crate) duration_s: Option<f64>,
+    /// A scenario file (`scenarios/*.toml`: times and commands); writes `summary.json` with
+    /// figures per segment and prints them as a table. Replaces `--drive`.
+    #[arg(long, conflicts_with = "drive")]
+    pub(crate) scenario: Option<PathBuf>,
+    /// Folder for telemetry.csv, bus.log (candump format) and the PNG plots.
+    #[arg(long, default_value = "out/sim")]
+    pub(crate) out: PathBuf,
+    /// Which shipped scene to load.
+    #[arg(long, value_enum, default_value = "flat")]
+    pub(crate) scene: Scene,
+    /// An MJCF file instead of a shipped scene.
+    #[arg(long)]
+    pub(crate) model: Option<PathBuf>,
+    /// Operator command at a time, `SECONDS:MODE` with MODE one of the report's keys W S A L K X
+    /// or `stand` / `fold`; repeat for a sequence. Without it no teleop node is on the bus and
+    /// the controller holds the robot where it stands.
+    #[arg(long = "drive", value_parser = parse_step)]
+    pub(crate) drive: Vec<PlanStep>,
+    /// Control rate, Hz (the model's timestep must divide the period).
+    #[arg(long, default_value_t = 250)]
+    pub(crate) control_hz: u32,
+    /// Lockstep: run at most this many times real time (1 = real time), still deterministic —
+    /// for watching, and for outside tools such as cansend and canplayer.
+    #[arg(long)]
+    pub(crate) pace: Option<f64>,
+    /// Lockstep: how long to wait for the controller's command each cycle, ms.
+    #[arg(long, default_value_t = 100)]
+    pub(crate) reply_timeout_ms: u64,
+    /// IMU gyro white noise, standard deviation, rad/s (`--gyro-noise`: the old name).
+    #[arg(long, default_value_t = 0.0, alias = "gyro-noise")]
+    pub(crate) gyro_noise_rad_s: f64,
+    /// IMU gyro bias on every axis, rad/s (`--gyro-bias`: the old name).
+    #[arg(long, default_value_t = 0.0, alias = "gyro-bias")]
+    pub(crate) gyro_bias_rad_s: f64,
+    /// IMU accelerometer white noise, standard deviation, m/s² (`--accel-noise`: the old name).
+    #[arg(long, default_value_t = 0.0, alias = "accel-noise")]
+    accel_noise_m_s2: f64,
+    /// Seed of the IMU noise.
+    #[arg(long, default_value_t = 1)]
+    pub(crate) seed: u64,
+    /// Skip the PNG plots.
+    #[arg(long)]
+    pub(crate) no_plots: bool,
+    /// No progress bar (for logs and scripts).
+    #[arg(long)]
+    pub(crate) no_progress: bool,
+    /// Open the interactive MuJoCo viewer, synced every control cycle; it stays open after the
+    /// run until closed, and closing it early ends the run. Needs a display; best with
+    /// `--clock wall` (lockstep plays faster than real time). Build with `--features viewer`.
+    #[arg(long)]
+    pub(crate) viewer: bool,
+    /// Render the model's `chase` camera to <out>/frames/frame_00000.png, … at the start and
+    /// every N control cycles (25 at 250 Hz: 10 frames per simulated second). Headless, through
+    /// EGL (Mesa: libegl1 libegl-mesa0 libgl1-mesa-dri). Build with `--features renderer`.
+    #[arg(long, value_name = "N")]
+    pub(crate) render_every: Option<NonZeroU32>,
+    /// Break the simulator's bus connection on purpose: `tx.*` faults hit the feedback it
+    /// sends, `rx.*` the commands it receives. Comma-separated, e.g.
+    /// `tx.drop=0.05,rx.delay=3,tx.flip=0.01,seed=7`; faults: drop, delay, duplicate, reorder,
+    /// flip, replay (probabilities 0…1, delay in control cycles), silence=NODE (`feedback`,
+    /// `Imu`, `LegDrive_FL`, …). SYNC is never faulted.
+    #[arg(long, value_name = "PLAN", default_value = "")]
+    pub(crate) faults: Faults,
+}
+
+fn parse_step(text: &str) -> Result<PlanStep, String> {
+    let (time, mode) = text
+        .split_once(':')
+        .ok_or_else(|| format!("`{text}`: expected SECONDS:MODE, e.g. 2:W"))?;
+    let seconds: f64 = time
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{time}` is not a number of seconds"))?;
+    if !(0.0..=1e6).contains(&seconds) {
+        return Err(format!("`{time}`: time must be 0…1e6 s"));
+    }
+    let mode = teleop_core::scenario::parse_mode(mode)
+        .ok_or_else(|| format!("`{mode}`: use W S A L K X, stand or fold"))?;
+    Ok(PlanStep {
+        at_us: (seconds * 1e6).round() as u64,
+        mode,
+        body_height_m: 0.0,
+        speed_scale_pct: 100.0,
+    })
+}
+
+/// Runs the session `args` describe and prints what it did.
+pub(crate) fn run(args: RunArgs) -> Result<(), String> {
+    if args.viewer && !cfg!(feature = "viewer") {
+        return Err(
+            "this sim-host was built without the viewer: cargo run -p sim-host --features viewer -- run --viewer …"
+                .into(),
+        );
+    }
+    if args.render_every.is_some() && !cfg!(feature = "renderer") {
+        return Err(
+            "this sim-host was built without the renderer: cargo run -p sim-host --features renderer -- run --render-every 25 …"
+                .into(),
+        );
+    }
+    let scenario = match &args.scenario {
+        Some(path) => Some(Scenario::load(path).map_err(|e| e.to_string())?),
+        None => None,
+    };
+    let duration_s = args
+        .duration_s
+        .or(scenario.as_ref().map(|s| s.duration_s))
+        .unwrap_or(10.0);
+    if !(duration_s.is_finite() && duration_s > 0.0) {
+        return Err(format!(
+            "--duration-s {duration_s} must be a positive number of seconds"
+        ));
+    }
+    let config = session_config(&args, scenario.as_ref(), duration_s);
+    tracing::info!(model = %config.model.display(), bus = %args.bus, "starting");
+    let report = session::run(&config).map_err(|e| e.to_string())?;
+    crate::report::print(&args, scenario.as_ref(), &report)
+}
+
+/// The session `args` (and the scenario, if one was given) describe.
+fn session_config(args: &RunArgs, scenario: Option<&Scenario>, duration_s: f64) -> SessionConfig {
+    let (teleop_plan, segments) = match scenario {
+        Some(s) => (
+            s.plan(),
+            s.steps
+                .iter()
+                .map(|step| SegmentSpec {
+                    start_s: step.plan.at_us as f64 * 1e-6,
+                    label: step.label.clone(),
+                    mode: mode_name(step.plan.mode),
+                })
+                .collect(),
+        ),
+        None => (args.drive.clone(), Vec::new()),
+    };
+    let model = args.model.clone().unwrap_or_else(|| {
+        PathBuf::from(match args.scene {
+            Scene::Flat => DEFAULT_MODEL,
+            Scene::Obstacles => OBSTACLES_MODEL,
+        })
+    });
+    let bus = match args.bus.as_str() {
+        "inproc" => BusChoice::Inproc,
+        ifname => BusChoice::SocketCan(ifname.to_owned()),
+    };
+    SessionConfig {
+        model,
+        bus,
+        clock: match args.clock {
+            ClockArg::Lockstep => Clock::Lockstep,
+            ClockArg::Wall => Clock::Realtime,
+        },
+        duration_s,
+        control_hz: args.control_hz,
+        reply_timeout: Duration::from_millis(args.reply_timeout_ms),
+        max_speed: args.pace,
+        imu_noise: ImuNoise {
+            gyro_std_rad_s: args.gyro_noise_rad_s,
+            gyro_bias_rad_s: [args.gyro_bias_rad_s; 3],
+            accel_std_m_s2: args.accel_noise_m_s2,
+            seed: args.seed,
+            ..ImuNoise::default()
+        },
+        teleop_plan,
+        attach: None,
+        faults: args.faults.clone(),
+        out_dir: Some(args.out.clone()),
+        plots: !args.no_plots,
+        progress: !args.no_progress,
+        frames: args.render_every.map(|every_cycles| FrameSettings {
+            dir: args.out.join("frames"),
+            every_cycles,
+        }),
+        viewer: args.viewer,
+        stop: Some(stop_on_ctrl_c()),
+        segments,
+    }
+}
+
+/// A flag that Ctrl-C sets, so that an interrupted run still writes its outputs. If the handler
+/// cannot be installed, Ctrl-C keeps its default effect (the process ends) and the run says so.
+fn stop_on_ctrl_c() -> Arc<AtomicBool> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        tracing::warn!("Ctrl-C will end the run without writing its outputs: {e}");
+    }
+    stop
+}
