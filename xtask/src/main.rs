@@ -14,6 +14,7 @@ mod fuzz;
 mod hil;
 mod mujoco;
 mod pil;
+mod same_run;
 mod setup;
 mod test;
 mod util;
@@ -54,6 +55,10 @@ Tasks:
                      silent feedback, a killed firmware, a restarted simulator, E-stops) on the
                      closed loop in-process; writes its table into docs/faults.md (--check: fail
                      if the table there is stale)
+  same-run REV       proof that behaviour did not change: builds sim-host at git revision REV
+                     and from the working tree, runs every shipped scenario with both, and
+                     compares summary.json (all but the wall-clock fields), bus.log and
+                     telemetry.csv
   demo [options]     the report's demonstration, closed loop (STOP, W, S, A, L, K, X): sets up,
                      builds, runs scenarios/report_demo.toml with the firmware on the in-process
                      CAN bus; writes out/ (summary.json, telemetry.csv, bus.log, plots, frames)
@@ -84,6 +89,7 @@ fn main() -> ExitCode {
         "pil" => pil::run(rest),
         "fuzz" => fuzz::run(rest),
         "faults" => faults::run(rest),
+        "same-run" => same_run::run(rest),
         "help" | "-h" | "--help" => {
             print!("{HELP}");
             Ok(())
