@@ -23,6 +23,7 @@ pub fn run() -> Result<(), String> {
     ]))?;
     crate::dbc::run(&["--check".to_string()])?;
     check_no_f64()?;
+    check_file_lengths()?;
     // The vcan suite needs a kernel with vcan and root; `cargo xtask hil` provides both (here
     // or in a VM), below.
     sh(cargo()
@@ -100,6 +101,47 @@ fn check_no_f64() -> Result<(), String> {
     } else {
         Err(format!(
             "f64 in a no_std crate (use f32):\n{}",
+            offenders.join("\n")
+        ))
+    }
+}
+
+/// Longest non-test source file, lines: a file longer than this holds more than one concept.
+const MAX_SOURCE_LINES: usize = 500;
+
+/// No non-test Rust source over [`MAX_SOURCE_LINES`] lines. Integration tests, benches,
+/// examples and fuzz targets are test code; in other files a trailing `#[cfg(test)]` module
+/// does not count.
+fn check_file_lengths() -> Result<(), String> {
+    let out = Command::new("git")
+        .args(["ls-files", "*.rs"])
+        .current_dir(root())
+        .output()
+        .map_err(|e| format!("could not run git ls-files: {e}"))?;
+    let mut offenders = Vec::new();
+    for path in String::from_utf8_lossy(&out.stdout).lines() {
+        let test_code = path.starts_with("fuzz/")
+            || ["tests", "benches", "examples"]
+                .iter()
+                .any(|dir| path.split('/').any(|part| part == *dir));
+        if test_code {
+            continue;
+        }
+        let text = std::fs::read_to_string(root().join(path))
+            .map_err(|e| format!("cannot read {path}: {e}"))?;
+        let lines = text
+            .lines()
+            .take_while(|line| line.trim() != "#[cfg(test)]")
+            .count();
+        if lines > MAX_SOURCE_LINES {
+            offenders.push(format!("{path}: {lines} lines"));
+        }
+    }
+    if offenders.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "source files over {MAX_SOURCE_LINES} lines (split them by concept):\n{}",
             offenders.join("\n")
         ))
     }

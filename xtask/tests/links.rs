@@ -35,6 +35,25 @@ fn pages(root: &Path) -> Vec<PathBuf> {
     pages
 }
 
+/// The README is a screen, not a notebook: measurements and explanations live in docs/.
+const README_MAX_BYTES: u64 = 10 * 1024;
+
+#[test]
+fn the_readme_fits_on_a_screen_and_the_changelog_exists() {
+    let root = root();
+    let readme = std::fs::metadata(root.join("README.md")).expect("README.md");
+    assert!(
+        readme.len() <= README_MAX_BYTES,
+        "README.md is {} bytes, over {README_MAX_BYTES}: move details into docs/*.md and link them",
+        readme.len()
+    );
+    let changelog = std::fs::read_to_string(root.join("CHANGELOG.md")).expect("CHANGELOG.md");
+    assert!(
+        changelog.contains("## [Unreleased]"),
+        "CHANGELOG.md has no `## [Unreleased]` section: add one (Keep a Changelog)"
+    );
+}
+
 #[test]
 fn every_relative_link_in_the_docs_resolves() {
     let root = root();
