@@ -10,24 +10,19 @@ use std::hint::black_box;
 use criterion::{criterion_group, criterion_main, Criterion};
 use firmware::{Config, Controller, Node, Tick};
 use protocol::{
-    Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, Frame, Imu, JointVelocity, Leg,
+    Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, Frame, Imu, JointVelocity, Joints,
     LegFeedback, QuatComponent, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, Torque,
     WheelAngle, WheelFeedback, WheelVelocity,
 };
 
-fn feedback(joints_rad: &[f32; 16]) -> Vec<AnyMessage> {
-    let mut messages: Vec<AnyMessage> = Leg::ALL
-        .iter()
-        .zip(joints_rad.chunks_exact(4))
-        .map(|(leg, chunk)| {
-            let mut position = [Angle::saturating_from_si(0.0); 4];
-            for (slot, value) in position.iter_mut().zip(chunk) {
-                *slot = Angle::saturating_from_si(*value);
-            }
+fn feedback(joints_rad: &Joints<f32>) -> Vec<AnyMessage> {
+    let mut messages: Vec<AnyMessage> = joints_rad
+        .iter_legs()
+        .map(|(leg, angles_rad)| {
             AnyMessage::LegFeedback(
-                *leg,
+                leg,
                 LegFeedback {
-                    position,
+                    position: angles_rad.map(Angle::saturating_from_si),
                     velocity: [JointVelocity::saturating_from_si(0.1); 4],
                     effort: [Torque::saturating_from_si(1.0); 4],
                 },
@@ -71,7 +66,7 @@ fn controller_in(mode: TeleopMode) -> (Controller, u32) {
         )),
     };
     let mut controller = Controller::new(Config::ROBOT).unwrap();
-    let mut joints = [0.0f32; 16];
+    let mut joints = Joints::splat(0.0_f32);
     for tick in 0..600 {
         for message in feedback(&joints) {
             controller.on_message(Tick(tick), &message);
@@ -99,7 +94,7 @@ fn bench_step(c: &mut Criterion) {
         ("step/wheels", TeleopMode::WheelForward),
     ] {
         let (mut controller, start) = controller_in(mode);
-        let mut messages = feedback(&[0.1; 16]);
+        let mut messages = feedback(&Joints::splat(0.1));
         messages.push(operator(mode)[0]);
         let expected = controller.state();
         let mut tick = start;
@@ -124,7 +119,7 @@ fn bench_step(c: &mut Criterion) {
 fn bench_node(c: &mut Criterion) {
     let mut node = Node::new(Config::ROBOT).unwrap();
     // Every counter value once, so the ring of frames wraps exactly as the counters do.
-    let messages = feedback(&[0.1; 16]);
+    let messages = feedback(&Joints::splat(0.1));
     let ring: Vec<Vec<Frame>> = (0..=u16::MAX)
         .map(|counter| {
             messages

@@ -11,7 +11,7 @@ use firmware::{Config, Controller, Tick};
 use proptest::prelude::*;
 use protocol::{
     Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, EStop, EStopAction, FaultFlags, Imu,
-    JointVelocity, Leg, LegFeedback, NodeId, QuatComponent, SpeedScale, TeleopCommand,
+    JointVelocity, Joints, Leg, LegFeedback, NodeId, QuatComponent, SpeedScale, TeleopCommand,
     TeleopHeartbeat, TeleopMode, Torque, WheelAngle, WheelFeedback, WheelVelocity,
 };
 
@@ -21,7 +21,7 @@ const CONFIG: Config = Config::ROBOT;
 struct Bench {
     controller: Controller,
     now: u32,
-    joints_rad: [f32; 16],
+    joints_rad: Joints<f32>,
     drives_alive: bool,
     imu_alive: bool,
     teleop_alive: bool,
@@ -57,9 +57,9 @@ impl Bench {
     fn tick(&mut self) -> Output {
         let now = Tick(self.now);
         if self.drives_alive {
-            for (leg, chunk) in Leg::ALL.iter().zip(self.joints_rad.chunks_exact(4)) {
+            for (leg, angles_rad) in self.joints_rad.iter_legs() {
                 self.controller
-                    .on_message(now, &AnyMessage::LegFeedback(*leg, leg_feedback(chunk)));
+                    .on_message(now, &AnyMessage::LegFeedback(leg, leg_feedback(angles_rad)));
             }
             self.controller.on_message(now, &wheels_at_rest());
         }
@@ -143,8 +143,8 @@ fn w_folds_the_legs_at_the_fold_rate_then_drives_on_the_wheels() {
         ))
     );
     // The fold: front hips at +50°, back hips at −45° (see `Posture::ROBOT`).
-    let front_hip = bench.joints_rad[1];
-    let back_hip = bench.joints_rad[9];
+    let front_hip = bench.joints_rad.leg(Leg::Fl)[1];
+    let back_hip = bench.joints_rad.leg(Leg::Bl)[1];
     assert!(
         (front_hip - 50f32.to_radians()).abs() < 0.011,
         "front hip {front_hip}"
@@ -385,11 +385,11 @@ proptest! {
             }
             now = now.wrapping_add(gap);
             let output = controller.step(Tick(now));
-            for (chunk_index, chunk) in output.leg_targets_rad.chunks_exact(4).enumerate() {
-                for (joint, angle) in firmware::limits::Joint::ALL.into_iter().zip(chunk) {
+            for (leg, angles) in output.leg_targets_rad.iter_legs() {
+                for (joint, angle) in firmware::limits::Joint::ALL.into_iter().zip(angles) {
                     prop_assert!(
                         angle.is_finite() && CONFIG.limits.range(joint).contains(*angle),
-                        "leg {chunk_index} {joint:?} = {angle}"
+                        "leg {leg:?} {joint:?} = {angle}"
                     );
                 }
             }

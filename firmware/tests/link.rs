@@ -15,7 +15,9 @@ use std::collections::HashMap;
 use firmware::control::controller::Output;
 use firmware::control::fsm::{Direction, LegMotion, State, WheelMotion};
 use firmware::{Config, Node, Tick};
-use protocol::{AnyMessage, ControllerMode, FaultFlags, RejectCause, TeleopHeartbeat, TeleopMode};
+use protocol::{
+    AnyMessage, ControllerMode, FaultFlags, Joints, RejectCause, TeleopHeartbeat, TeleopMode,
+};
 
 const CONFIG: Config = Config::ROBOT;
 const TROT_F: State = State::Legs(LegMotion::Trot(Direction::Forward));
@@ -24,7 +26,7 @@ const TROT_F: State = State::Legs(LegMotion::Trot(Direction::Forward));
 struct LossyBench {
     node: Node,
     now: u32,
-    joints_rad: [f32; 16],
+    joints_rad: Joints<f32>,
     /// The teleop's mode, sent every 20 ms like the real one.
     mode: TeleopMode,
     /// Drop every n-th frame of each identifier (`None`: a clean bus).

@@ -6,8 +6,8 @@ use firmware::control::fsm::{Direction, LegMotion, State, WheelMotion};
 use firmware::node::TELEOP_COMMANDS_PER_TICK;
 use firmware::{Config, Node, Tick};
 use protocol::{
-    decode_frame, AnyMessage, DecodeError, DriveEnable, EStop, EStopAction, MessageId, NodeId,
-    RejectCause, TeleopHeartbeat, TeleopMode,
+    decode_frame, AnyMessage, DecodeError, DriveEnable, EStop, EStopAction, Joints, MessageId,
+    NodeId, RejectCause, TeleopHeartbeat, TeleopMode,
 };
 
 fn teleop_frame(mode: TeleopMode, counter: u16) -> protocol::Frame {
@@ -105,7 +105,7 @@ fn the_readmes_cansend_estop_latches_and_clears() {
 
 /// The feedback of one tick (four legs at zero, wheels, IMU) with rolling counter `counter`.
 fn feedback_frames(counter: u16) -> Vec<protocol::Frame> {
-    common::plant_feedback(&[0.0; 16])
+    common::plant_feedback(&Joints::splat(0.0))
         .iter()
         .map(|m| m.encode(counter).unwrap())
         .collect()

@@ -92,11 +92,11 @@ proptest! {
             }
             now = now.wrapping_add(gap);
             let (output, frames) = node.poll(Tick(now));
-            for (leg, chunk) in output.leg_targets_rad.chunks_exact(4).enumerate() {
-                for (joint, angle) in Joint::ALL.into_iter().zip(chunk) {
+            for (leg, angles) in output.leg_targets_rad.iter_legs() {
+                for (joint, angle) in Joint::ALL.into_iter().zip(angles) {
                     prop_assert!(
                         angle.is_finite() && CONFIG.limits.range(joint).contains(*angle),
-                        "leg {leg} {joint:?} = {angle}"
+                        "leg {leg:?} {joint:?} = {angle}"
                     );
                 }
             }

@@ -55,7 +55,7 @@ fn wrong_length_is_rejected_and_counted() {
     let frame = encode(
         &LegTargets {
             enable: DriveEnable::Enabled,
-            position: [Angle::default(); 16],
+            position: [Angle::default(); 16].into(),
         },
         (),
         0,

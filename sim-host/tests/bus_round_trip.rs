@@ -10,8 +10,9 @@ use std::time::Duration;
 use host_can::bus::Bus;
 use host_can::inproc_bus::{InprocBus, InprocEndpoint};
 use protocol::{
-    Angle, AnyMessage, DriveEnable, DriveFlags, DriveStatus, E2eCounter, EStop, EStopAction, Frame,
-    Leg, LegFeedback, LegTargets, NodeId, Receiver, Torque, WheelCommand, WheelFeedback,
+    Angle, AnyMessage, Drive, DriveEnable, DriveFlags, DriveStatus, E2eCounter, EStop, EStopAction,
+    Frame, Joints, Leg, LegFeedback, LegTargets, NodeId, PerDrive, Receiver, Torque, WheelCommand,
+    WheelFeedback,
 };
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
@@ -36,7 +37,7 @@ struct TestController {
     receiver: Receiver,
     leg_counter: E2eCounter,
     wheel_counter: E2eCounter,
-    targets_rad: [f32; 16],
+    targets_rad: Joints<f32>,
     wheel_torque_nm: [f32; 2],
     plan: Plan,
     extra: Vec<Frame>,
@@ -44,7 +45,7 @@ struct TestController {
     leg_feedback: [Option<LegFeedback>; 4],
     wheel_feedback: Option<WheelFeedback>,
     imu_gyro: Vec<[f32; 3]>,
-    drive_status: [Option<DriveStatus>; 5],
+    drive_status: PerDrive<Option<DriveStatus>>,
     feedback_frames: u64,
 }
 
@@ -64,7 +65,7 @@ impl TestController {
             leg_feedback: [None; 4],
             wheel_feedback: None,
             imu_gyro: Vec::new(),
-            drive_status: [None; 5],
+            drive_status: PerDrive::splat(None),
             feedback_frames: 0,
         }
     }
@@ -86,7 +87,7 @@ impl TestController {
                 }
                 AnyMessage::Imu(imu) => self.imu_gyro.push(imu.angular_rate.map(|r| r.si())),
                 AnyMessage::DriveStatus(drive, status) => {
-                    self.drive_status[drive as usize] = Some(status)
+                    *self.drive_status.get_mut(drive) = Some(status)
                 }
                 _ => {}
             }
@@ -165,12 +166,14 @@ fn leg_drives_servo_to_the_frames_targets_and_report_every_cycle() {
     // Abduct the front-left leg by 0.15 rad and bend its knee 0.1 rad more.
     {
         let mut c = ctl.borrow_mut();
-        c.targets_rad[0] += 0.15;
-        c.targets_rad[2] -= 0.10;
+        let fl = c.targets_rad.leg_mut(Leg::Fl);
+        fl[0] += 0.15;
+        fl[2] -= 0.10;
     }
     let wanted = {
         let c = ctl.borrow();
-        [c.targets_rad[0], c.targets_rad[2]]
+        let fl = c.targets_rad.leg(Leg::Fl);
+        [fl[0], fl[2]]
     };
     let missed = run(&mut sim, &mut bus, &ctl, HZ as u64, |_| {});
     assert_eq!(missed, 0, "every cycle the command arrived");
@@ -193,15 +196,15 @@ fn leg_drives_servo_to_the_frames_targets_and_report_every_cycle() {
     }
     // The physics agrees with the feedback (to the wire's 1e-4 rad).
     let truth = sim.physics().leg_positions_rad();
-    assert!((truth[0] as f32 - got[0]).abs() < 2e-4);
+    assert!((truth.leg(Leg::Fl)[0] as f32 - got[0]).abs() < 2e-4);
     // Every drive reports itself enabled and counts the commands it took.
-    for (i, status) in c.drive_status.iter().enumerate() {
-        let status = status.unwrap_or_else(|| panic!("no status from drive {i}"));
+    for (drive, status) in c.drive_status.iter_drives() {
+        let status = status.unwrap_or_else(|| panic!("no status from drive {drive:?}"));
         assert!(
             status.flags.contains(DriveFlags::ENABLED),
-            "drive {i}: {status:?}"
+            "drive {drive:?}: {status:?}"
         );
-        assert!(status.commands.raw() > 200, "drive {i}: {status:?}");
+        assert!(status.commands.raw() > 200, "drive {drive:?}: {status:?}");
     }
     // The robot still stands.
     let z = sim.physics().torso().pos_m[2];
@@ -251,15 +254,15 @@ fn drives_go_torque_free_100_ms_after_the_last_command_and_say_so() {
         "torque off {off_after_ms} ms after the last command"
     );
     let c = ctl.borrow();
-    for (i, status) in c.drive_status.iter().enumerate() {
+    for (drive, status) in c.drive_status.iter_drives() {
         let status = status.unwrap();
         assert!(
             status.flags.contains(DriveFlags::TIMED_OUT),
-            "drive {i}: {status:?}"
+            "drive {drive:?}: {status:?}"
         );
         assert!(
             !status.flags.contains(DriveFlags::ENABLED),
-            "drive {i}: {status:?}"
+            "drive {drive:?}: {status:?}"
         );
     }
     // Torque-free legs cannot carry the torso: it sinks onto its wheels.
@@ -271,11 +274,11 @@ fn corrupted_and_replayed_commands_are_rejected_counted_and_never_applied() {
     let (mut sim, mut bus, ctl) = setup();
     // Settle first, so that the only thing that could move the hips is the bad frame.
     run(&mut sim, &mut bus, &ctl, 250, |_| {});
-    let before = sim.physics().leg_positions_rad()[1];
+    let before = sim.physics().leg_positions_rad().leg(Leg::Fl)[1];
     // A corrupted frame that would swing every hip forward by 0.5 rad.
     let mut evil_targets = ctl.borrow().targets_rad;
-    for leg in 0..4 {
-        evil_targets[4 * leg + 1] += 0.5;
+    for leg in Leg::ALL {
+        evil_targets.leg_mut(leg)[1] += 0.5;
     }
     let evil = AnyMessage::LegTargets(LegTargets {
         enable: DriveEnable::Enabled,
@@ -295,7 +298,7 @@ fn corrupted_and_replayed_commands_are_rejected_counted_and_never_applied() {
     run(&mut sim, &mut bus, &ctl, 1, |_| {});
     ctl.borrow_mut().plan = Plan::Command;
     run(&mut sim, &mut bus, &ctl, 50, |_| {});
-    let after = sim.physics().leg_positions_rad()[1];
+    let after = sim.physics().leg_positions_rad().leg(Leg::Fl)[1];
     assert!(
         (after - before).abs() < 0.02,
         "hip moved {before:.3} → {after:.3}"
@@ -305,7 +308,7 @@ fn corrupted_and_replayed_commands_are_rejected_counted_and_never_applied() {
     for leg in sim.hardware().legs() {
         assert_eq!(leg.core().rejected(), 2, "{:?}", leg.leg());
     }
-    let status = ctl.borrow().drive_status[Leg::Fl as usize].unwrap();
+    let status = ctl.borrow().drive_status.get(Drive::LegFl).unwrap();
     assert_eq!(status.rejected.raw(), 2);
 }
 

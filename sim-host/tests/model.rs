@@ -70,11 +70,10 @@ fn folded_on_free_wheels_it_tips_over() {
     let posture = firmware::config::Config::ROBOT.posture;
     let front = posture.fold_front.to_array();
     let back = posture.fold_back.to_array();
-    let mut legs = [0.0; 16];
-    for (i, angle) in legs.iter_mut().enumerate() {
-        let pose = if i < 8 { &front } else { &back };
-        *angle = f64::from(pose[i % 4]);
-    }
+    let legs = protocol::Joints::from_leg_fn(|leg| {
+        let pose = if (leg as usize) < 2 { front } else { back };
+        pose.map(f64::from)
+    });
     // Wheels (r 0.12 at z −0.15) just on the ground, torso level, wheels unpowered.
     p.place(0.12 + 0.15 + 0.001, &legs);
     let mut max_tilt_deg: f64 = 0.0;

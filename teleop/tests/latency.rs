@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use host_can::bus::Bus;
 use host_can::inproc_bus::{InprocBus, InprocEndpoint};
-use protocol::{decode_frame, AnyMessage, ControllerMode, DriveEnable, FaultFlags, Frame};
+use protocol::{decode_frame, AnyMessage, ControllerMode, DriveEnable, FaultFlags, Frame, Joints};
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
 use sim_host::robot::imu::ImuNoise;
@@ -22,14 +22,14 @@ use teleop_core::keys::Key;
 const PERIOD_MS: u64 = 4;
 
 /// The leg targets in `frame`, if it is a LegTargets frame.
-fn leg_targets(frame: &Frame) -> Option<(DriveEnable, [f32; 16])> {
+fn leg_targets(frame: &Frame) -> Option<(DriveEnable, Joints<f32>)> {
     match decode_frame(frame.id(), frame.data()).ok()?.message {
         AnyMessage::LegTargets(t) => Some((t.enable, t.position.map(|a| a.si()))),
         _ => None,
     }
 }
 
-fn changed(a: &[f32; 16], b: &[f32; 16]) -> bool {
+fn changed(a: &Joints<f32>, b: &Joints<f32>) -> bool {
     a.iter().zip(b).any(|(x, y)| (x - y).abs() > 1e-4)
 }
 
@@ -37,7 +37,7 @@ fn changed(a: &[f32; 16], b: &[f32; 16]) -> bool {
 /// the press to the first LegTargets that `reflects` it.
 fn lockstep_latency(
     key: Key,
-    reflects: impl Fn(&(DriveEnable, [f32; 16]), &[f32; 16]) -> bool,
+    reflects: impl Fn(&(DriveEnable, Joints<f32>), &Joints<f32>) -> bool,
 ) -> u32 {
     let press_cycle = 250;
     let mut sim = Simulator::new(
@@ -54,7 +54,7 @@ fn lockstep_latency(
     let mut teleop_bus = bus.endpoint();
     let mut probe = bus.endpoint();
     let mut app = App::new("inproc");
-    let mut before = None::<[f32; 16]>;
+    let mut before = None::<Joints<f32>>;
     let seen = std::cell::Cell::new(None);
     lockstep::run(
         &mut sim,

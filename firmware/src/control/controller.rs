@@ -9,7 +9,9 @@
 //! 4. the legs' targets move toward the goal with the report's smoothing;
 //! 5. every output is clamped to the joint and torque limits and made finite.
 
-use protocol::{AnyMessage, ControllerMode, Drive, DriveFlags, EStopAction, FaultFlags};
+use protocol::{
+    AnyMessage, ControllerMode, DriveFlags, EStopAction, FaultFlags, Joints, Leg, PerDrive,
+};
 
 use crate::config::Config;
 use crate::control::fsm::{Direction, Event, LegMotion, State, WheelMotion};
@@ -28,8 +30,8 @@ use crate::wheels::wheel::{mix, SpeedLoop};
 pub struct Output {
     /// Whether the leg drives should servo (false: torque-free).
     pub legs_enabled: bool,
-    /// Leg joint targets, wire order, rad; within the joint ranges and finite.
-    pub leg_targets_rad: [f32; 16],
+    /// Leg joint targets, rad; within the joint ranges and finite.
+    pub leg_targets_rad: Joints<f32>,
     /// Wheel torques (left, right), N·m; within the torque limit and finite.
     pub wheel_torque_nm: [f32; 2],
     /// Telemetry.
@@ -76,16 +78,16 @@ pub struct Controller {
     trot: Trot,
     balance: Balance,
     turn: SpeedLoop,
-    /// Smoothed leg targets, wire order.
-    legs_rad: [f32; 16],
-    /// Goal of the smoothing, wire order (kept so a failed IK holds the previous goal).
-    goal_rad: [f32; 16],
+    /// Smoothed leg targets, rad.
+    legs_rad: Joints<f32>,
+    /// Goal of the smoothing, rad (kept so a failed IK holds the previous goal).
+    goal_rad: Joints<f32>,
     /// The fold pose of all legs, clamped into the joint ranges once at construction.
-    fold_rad: [f32; 16],
+    fold_rad: Joints<f32>,
     /// Whether the drives have reported positions so the targets start from them.
     armed: bool,
-    /// Latest fault report of each drive, in [`Drive::ALL`] order.
-    drive_faults: [bool; 5],
+    /// Latest fault report of each drive.
+    drive_faults: PerDrive<bool>,
     tilted: bool,
     non_finite: bool,
     /// Whether the node's link monitor finds the bus too lossy (see [`Controller::set_link_degraded`]).
@@ -109,11 +111,11 @@ impl Controller {
             trot,
             balance: Balance::new(config.balance),
             turn: SpeedLoop::new(config.turn),
-            legs_rad: [0.0; 16],
-            goal_rad: [0.0; 16],
+            legs_rad: Joints::splat(0.0),
+            goal_rad: Joints::splat(0.0),
             fold_rad: fold_goal(&config),
             armed: false,
-            drive_faults: [false; 5],
+            drive_faults: PerDrive::splat(false),
             tilted: false,
             non_finite: false,
             link_degraded: false,
@@ -194,11 +196,7 @@ impl Controller {
             }
             AnyMessage::DriveStatus(drive, status) => {
                 let faulted = status.flags.contains(DriveFlags::FAULT);
-                if let Some(index) = Drive::ALL.iter().position(|d| d == drive) {
-                    if let Some(slot) = self.drive_faults.get_mut(index) {
-                        *slot = faulted;
-                    }
-                }
+                *self.drive_faults.get_mut(*drive) = faulted;
                 if faulted {
                     self.apply(Event::Fault);
                 }
@@ -412,9 +410,9 @@ impl Controller {
                     .stance(&config.geometry, &config.limits, depth_m); 4]
             }
         };
-        for (goal, slot) in goals.iter().zip(self.goal_rad.chunks_exact_mut(4)) {
+        for (leg, goal) in Leg::ALL.into_iter().zip(goals) {
             match goal {
-                Ok(joints) => slot.copy_from_slice(&joints.to_array()),
+                Ok(joints) => *self.goal_rad.leg_mut(leg) = joints.to_array(),
                 Err(_) => self.ik_failures = self.ik_failures.saturating_add(1),
             }
         }
@@ -463,13 +461,13 @@ impl Controller {
 }
 
 /// The fold pose for all four legs, clamped into the joint ranges.
-fn fold_goal(config: &Config) -> [f32; 16] {
+fn fold_goal(config: &Config) -> Joints<f32> {
     let front = config.posture.fold_front.to_array();
     let back = config.posture.fold_back.to_array();
-    let mut goal = [0.0; 16];
-    for (leg, chunk) in goal.chunks_exact_mut(4).enumerate() {
-        chunk.copy_from_slice(if leg < 2 { &front } else { &back });
-    }
+    let mut goal = Joints::from_leg_fn(|leg| match leg {
+        Leg::Fl | Leg::Fr => front,
+        Leg::Bl | Leg::Br => back,
+    });
     let fallback = goal;
     clamp_leg_targets(&config.limits, &mut goal, &fallback);
     goal

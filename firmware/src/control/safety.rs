@@ -1,5 +1,7 @@
 //! The safety supervisor's parts: watchdogs in ticks, and the last clamp every output passes.
 
+use protocol::{Joints, Leg};
+
 use crate::limits::{Joint, JointLimits};
 use crate::time::Tick;
 
@@ -43,19 +45,18 @@ impl Watchdog {
     }
 }
 
-/// Clamps the 16 leg targets (wire order) into `limits`. A non-finite target is replaced by
+/// Clamps the 16 leg targets into `limits`. A non-finite target is replaced by
 /// `fallback` (the last safe target of that joint, itself clamped). Returns whether any value
 /// was non-finite.
 pub fn clamp_leg_targets(
     limits: &JointLimits,
-    targets_rad: &mut [f32; 16],
-    fallback_rad: &[f32; 16],
+    targets_rad: &mut Joints<f32>,
+    fallback_rad: &Joints<f32>,
 ) -> bool {
     let mut replaced = false;
-    for (leg_targets, leg_fallbacks) in targets_rad
-        .chunks_exact_mut(4)
-        .zip(fallback_rad.chunks_exact(4))
-    {
+    for leg in Leg::ALL {
+        let leg_targets = targets_rad.leg_mut(leg);
+        let leg_fallbacks = fallback_rad.leg(leg);
         for ((target, fallback), joint) in leg_targets.iter_mut().zip(leg_fallbacks).zip(Joint::ALL)
         {
             replaced |= !target.is_finite();

@@ -1,6 +1,6 @@
 //! The latest feedback from the drives and the IMU, in SI units, with a watchdog per source.
 
-use protocol::{Imu, Leg, LegFeedback, WheelFeedback};
+use protocol::{Imu, Joints, Leg, LegFeedback, WheelFeedback};
 
 use crate::attitude::Attitude;
 use crate::control::safety::Watchdog;
@@ -9,10 +9,10 @@ use crate::time::Tick;
 /// The newest samples and how fresh they are.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Sensors {
-    /// Joint positions, wire order (4 per leg), rad.
-    pub joint_position_rad: [f32; 16],
-    /// Joint velocities, wire order, rad/s.
-    pub joint_velocity_rad_s: [f32; 16],
+    /// Joint positions, rad.
+    pub joint_position_rad: Joints<f32>,
+    /// Joint velocities, rad/s.
+    pub joint_velocity_rad_s: Joints<f32>,
     /// Wheel joint rates (left, right), relative to the body, rad/s.
     pub wheel_rate_rad_s: [f32; 2],
     /// Torso attitude.
@@ -28,8 +28,8 @@ impl Sensors {
     /// Nothing received yet; watchdogs of `feedback_ticks` (drives) and `imu_ticks`.
     pub const fn new(feedback_ticks: u32, imu_ticks: u32) -> Self {
         Self {
-            joint_position_rad: [0.0; 16],
-            joint_velocity_rad_s: [0.0; 16],
+            joint_position_rad: Joints::splat(0.0),
+            joint_velocity_rad_s: Joints::splat(0.0),
             wheel_rate_rad_s: [0.0; 2],
             attitude: Attitude {
                 pitch_rad: 0.0,
@@ -44,17 +44,8 @@ impl Sensors {
 
     /// Stores one leg's feedback.
     pub fn record_leg(&mut self, now: Tick, leg: Leg, feedback: &LegFeedback) {
-        let first = leg_index(leg) * 4;
-        for (joint, (position, velocity)) in
-            feedback.position.iter().zip(&feedback.velocity).enumerate()
-        {
-            if let Some(slot) = self.joint_position_rad.get_mut(first + joint) {
-                *slot = position.si();
-            }
-            if let Some(slot) = self.joint_velocity_rad_s.get_mut(first + joint) {
-                *slot = velocity.si();
-            }
-        }
+        *self.joint_position_rad.leg_mut(leg) = feedback.position.map(|p| p.si());
+        *self.joint_velocity_rad_s.leg_mut(leg) = feedback.velocity.map(|v| v.si());
         if let Some(watchdog) = self.legs.get_mut(leg_index(leg)) {
             watchdog.feed(now);
         }

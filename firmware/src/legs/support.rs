@@ -6,6 +6,8 @@
 //! hips, from the measured joint angles) plus the foot radius; the wheels touch once that
 //! height falls to the wheels' contact height (mount depth + wheel radius).
 
+use protocol::Joints;
+
 use crate::legs::kinematics::{leg_fk, LegGeometry, LegJoints};
 
 /// Dimensions that decide which part touches the ground.
@@ -30,22 +32,12 @@ impl SupportGeometry {
 
     /// The torso-centre height the legs give on flat ground, m: the deepest foot + its radius.
     /// Non-finite joint angles give 0 (the wheels are assumed to carry the robot).
-    pub fn leg_height_m(&self, geometry: &LegGeometry, joints_rad: &[f32; 16]) -> f32 {
+    pub fn leg_height_m(&self, geometry: &LegGeometry, joints_rad: &Joints<f32>) -> f32 {
         let mut deepest_m: f32 = 0.0;
-        for leg in joints_rad.chunks_exact(4) {
-            if let &[hip_abduction_rad, hip_pitch_rad, knee_rad, ankle_rad] = leg {
-                let foot = leg_fk(
-                    geometry,
-                    &LegJoints {
-                        hip_abduction_rad,
-                        hip_pitch_rad,
-                        knee_rad,
-                        ankle_rad,
-                    },
-                );
-                if foot.z_m.is_finite() {
-                    deepest_m = deepest_m.max(-foot.z_m);
-                }
+        for (_, &angles_rad) in joints_rad.iter_legs() {
+            let foot = leg_fk(geometry, &LegJoints::from_array(angles_rad));
+            if foot.z_m.is_finite() {
+                deepest_m = deepest_m.max(-foot.z_m);
             }
         }
         deepest_m + self.foot_radius_m
@@ -53,7 +45,7 @@ impl SupportGeometry {
 
     /// Whether the wheels are on the ground (the legs hold the torso no higher than the wheels'
     /// contact height + margin).
-    pub fn wheels_grounded(&self, geometry: &LegGeometry, joints_rad: &[f32; 16]) -> bool {
+    pub fn wheels_grounded(&self, geometry: &LegGeometry, joints_rad: &Joints<f32>) -> bool {
         self.leg_height_m(geometry, joints_rad) <= self.wheel_contact_height_m + self.margin_m
     }
 }

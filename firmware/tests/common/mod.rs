@@ -4,13 +4,13 @@
 
 use firmware::config::Config;
 use protocol::{
-    Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, Imu, JointVelocity, Leg, LegFeedback,
-    QuatComponent, SpeedScale, TeleopCommand, TeleopMode, Torque, WheelAngle, WheelFeedback,
-    WheelVelocity,
+    Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, Imu, JointVelocity, Joints,
+    LegFeedback, QuatComponent, SpeedScale, TeleopCommand, TeleopMode, Torque, WheelAngle,
+    WheelFeedback, WheelVelocity,
 };
 
-/// Every leg at the nominal stance of `config`, wire order, rad: the robot standing.
-pub fn standing_joints_rad(config: &Config) -> [f32; 16] {
+/// Every leg at the nominal stance of `config`, rad: the robot standing.
+pub fn standing_joints_rad(config: &Config) -> Joints<f32> {
     let stance = config
         .posture
         .stance(
@@ -20,11 +20,7 @@ pub fn standing_joints_rad(config: &Config) -> [f32; 16] {
         )
         .expect("the nominal stance is reachable")
         .to_array();
-    let mut joints = [0.0; 16];
-    for chunk in joints.chunks_exact_mut(4) {
-        chunk.copy_from_slice(&stance);
-    }
-    joints
+    Joints::from_leg_fn(|_| stance)
 }
 
 /// A bench stepped one control tick at a time.
@@ -74,13 +70,12 @@ pub fn imu(pitch_rad: f32) -> Imu {
     }
 }
 
-/// One tick of an ideal plant's feedback: the four legs at `joints_rad` (wire order), the
-/// wheels at rest, the torso level.
-pub fn plant_feedback(joints_rad: &[f32; 16]) -> Vec<AnyMessage> {
-    let mut messages: Vec<AnyMessage> = Leg::ALL
-        .iter()
-        .zip(joints_rad.chunks_exact(4))
-        .map(|(leg, chunk)| AnyMessage::LegFeedback(*leg, leg_feedback(chunk)))
+/// One tick of an ideal plant's feedback: the four legs at `joints_rad`, the wheels at rest,
+/// the torso level.
+pub fn plant_feedback(joints_rad: &Joints<f32>) -> Vec<AnyMessage> {
+    let mut messages: Vec<AnyMessage> = joints_rad
+        .iter_legs()
+        .map(|(leg, angles_rad)| AnyMessage::LegFeedback(leg, leg_feedback(angles_rad)))
         .collect();
     messages.push(wheels_at_rest());
     messages.push(AnyMessage::Imu(imu(0.0)));

@@ -2,6 +2,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::codec::{check_layout, Message};
 use crate::id::MessageId;
+use crate::joints::Joints;
 use crate::node::JOINT_NAMES;
 use crate::signal::{array, scalar, Field};
 use crate::units::{Angle, DriveEnable};
@@ -27,7 +28,7 @@ pub struct LegTargets {
     /// Servo or go torque-free.
     pub enable: DriveEnable,
     /// Joint targets, in [`JOINT_NAMES`] order.
-    pub position: [Angle; 16],
+    pub position: Joints<Angle>,
 }
 
 impl Message for LegTargets {

@@ -35,8 +35,12 @@ pub fn any_message() -> impl Strategy<Value = AnyMessage> {
         (pick(EStopAction::ALL), pick(&NodeId::ALL))
             .prop_map(|(action, source)| AnyMessage::EStop(EStop { action, source })),
         tick().prop_map(|tick| AnyMessage::Sync(Sync { tick })),
-        (pick(DriveEnable::ALL), proptest::array::uniform16(angle()))
-            .prop_map(|(enable, position)| AnyMessage::LegTargets(LegTargets { enable, position })),
+        (pick(DriveEnable::ALL), proptest::array::uniform16(angle())).prop_map(
+            |(enable, position)| AnyMessage::LegTargets(LegTargets {
+                enable,
+                position: position.into()
+            })
+        ),
         proptest::array::uniform2(torque())
             .prop_map(|torque| AnyMessage::WheelCommand(WheelCommand { torque })),
         (

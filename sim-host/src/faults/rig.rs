@@ -12,7 +12,7 @@ use host_can::bus::Bus;
 use host_can::fault_plan::Faults;
 use host_can::faulty_bus::{FaultStats, FaultyBus};
 use host_can::inproc_bus::{InprocBus, InprocEndpoint};
-use protocol::{FaultFlags, Frame, RejectCause, RejectCounters};
+use protocol::{FaultFlags, Frame, Joints, PerDrive, RejectCause, RejectCounters};
 use teleop_core::scripted::{PlanStep, ScriptedTeleop};
 
 use crate::clock::lockstep;
@@ -45,16 +45,16 @@ pub struct CycleRecord {
     pub state: Option<State>,
     /// The firmware's active faults.
     pub faults: FaultFlags,
-    /// The firmware's leg targets, wire order, rad, and whether the legs are enabled.
-    pub leg_targets_rad: Option<([f32; 16], bool)>,
+    /// The firmware's leg targets, rad, and whether the legs are enabled.
+    pub leg_targets_rad: Option<(Joints<f32>, bool)>,
     /// The firmware's wheel torques, N·m.
     pub wheel_torque_nm: Option<[f32; 2]>,
-    /// Per drive (4 legs, wheels): torque-free now.
-    pub torque_off: [bool; 5],
+    /// Per drive: torque-free now.
+    pub torque_off: PerDrive<bool>,
     /// Per drive: reporting a command timeout.
-    pub timed_out: [bool; 5],
+    pub timed_out: PerDrive<bool>,
     /// Per drive: E-stop latched.
-    pub estop: [bool; 5],
+    pub estop: PerDrive<bool>,
     /// Whether the controller's wheel command arrived this cycle.
     pub commanded: bool,
 }
@@ -192,13 +192,13 @@ impl Rig {
         let torso = physics.torso();
         let now_us = self.sim.now_us();
         let hardware = self.sim.hardware();
-        let cores: [&DriveCore; 5] = [
+        let cores = PerDrive::new([
             hardware.legs()[0].core(),
             hardware.legs()[1].core(),
             hardware.legs()[2].core(),
             hardware.legs()[3].core(),
             hardware.wheel().core(),
-        ];
+        ]);
         let output = self.controller.as_ref().and_then(|c| c.last_output());
         CycleRecord {
             time_us: self.time_us,

@@ -207,9 +207,10 @@ impl SegmentTracker {
         let contacts = physics.ground_contacts();
         s.fell |= tilt > FALLEN_TILT_DEG || contacts.torso;
         let mut excess: f64 = 0.0;
-        for (i, angle) in physics.leg_positions_rad().iter().enumerate() {
-            let (lo, hi) = self.limits[i % 4];
-            excess = excess.max(lo - angle).max(angle - hi);
+        for (_, angles) in physics.leg_positions_rad().iter_legs() {
+            for (angle, (lo, hi)) in angles.iter().zip(self.limits) {
+                excess = excess.max(lo - angle).max(angle - hi);
+            }
         }
         s.max_joint_excess_deg = s.max_joint_excess_deg.max(excess.max(0.0).to_degrees());
         if excess > JOINT_TOLERANCE_RAD {

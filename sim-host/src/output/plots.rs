@@ -363,10 +363,7 @@ mod tests {
         (0..count)
             .map(|i| {
                 let t = i as f64 * 0.004;
-                let mut leg_joint_rad = [0.0; 16];
-                for (j, angle) in leg_joint_rad.iter_mut().enumerate() {
-                    *angle = (t * 3.0 + j as f64).sin() * 0.5;
-                }
+                let leg_joint_rad = protocol::Joints::from_fn(|j| (t * 3.0 + j as f64).sin() * 0.5);
                 let mode = match i * 3 / count {
                     0 if i < 5 => None,
                     0 => Some(ControllerMode::Stop),

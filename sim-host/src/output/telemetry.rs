@@ -1,7 +1,7 @@
 //! What the simulator records each step for the user: ground truth from MuJoCo and what the
 //! bus said, one [`TelemetryRow`] per recorded step.
 
-use protocol::ControllerMode;
+use protocol::{ControllerMode, Joints};
 
 /// One recorded simulation step. Angles are ground truth from the simulator, not estimates.
 #[derive(Debug, Clone, PartialEq)]
@@ -12,8 +12,8 @@ pub struct TelemetryRow {
     pub torso_pos_m: [f64; 3],
     /// Torso roll, pitch (+ = nose down), yaw (+ = turning left), degrees.
     pub torso_rpy_deg: [f64; 3],
-    /// Leg joint angles in [`protocol::JOINT_NAMES`] order, rad.
-    pub leg_joint_rad: [f64; 16],
+    /// Leg joint angles, rad.
+    pub leg_joint_rad: Joints<f64>,
     /// Wheel torques applied by the wheel drive, left and right, N·m (+ = forward).
     pub wheel_torque_nm: [f64; 2],
     /// Wheel speeds, left and right, rad/s (+ = rolling forward).

@@ -91,15 +91,11 @@ mod tests {
     use protocol::ControllerMode;
 
     fn row(time_s: f64, mode: Option<ControllerMode>) -> TelemetryRow {
-        let mut leg_joint_rad = [0.0; 16];
-        for (i, angle) in leg_joint_rad.iter_mut().enumerate() {
-            *angle = i as f64 * 0.01;
-        }
         TelemetryRow {
             time_s,
             torso_pos_m: [1.5, -0.25, 0.3],
             torso_rpy_deg: [0.5, -2.0, 90.0],
-            leg_joint_rad,
+            leg_joint_rad: protocol::Joints::from_fn(|i| i as f64 * 0.01),
             wheel_torque_nm: [0.75, -0.125],
             wheel_speed_rad_s: [10.0, 11.0],
             foot_force_n: [0.0; 4],

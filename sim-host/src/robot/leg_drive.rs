@@ -3,8 +3,8 @@
 //! joint position, velocity and torque in a `LegFeedback` frame.
 
 use protocol::{
-    Angle, AnyMessage, DriveEnable, E2eCounter, Frame, JointVelocity, Leg, LegFeedback, MessageId,
-    Torque,
+    Angle, AnyMessage, DriveEnable, E2eCounter, Frame, JointVelocity, Joints, Leg, LegFeedback,
+    MessageId, Torque,
 };
 
 use crate::robot::drive_core::{Authority, DriveCore};
@@ -48,14 +48,7 @@ impl LegDrive {
     /// Takes a frame from the bus (see [`DriveCore::on_frame`]).
     pub fn on_frame(&mut self, now_us: u64, frame: &Frame) {
         if let Some(AnyMessage::LegTargets(targets)) = self.core.on_frame(now_us, frame) {
-            let first = 4 * self.leg as usize;
-            for (mine, wire) in self
-                .targets_rad
-                .iter_mut()
-                .zip(targets.position.iter().skip(first))
-            {
-                *mine = f64::from(wire.si());
-            }
+            self.targets_rad = targets.position.leg(self.leg).map(|a| f64::from(a.si()));
             self.core
                 .set_commanded_enable(targets.enable == DriveEnable::Enabled);
         }
@@ -66,7 +59,7 @@ impl LegDrive {
         let leg = self.leg as usize;
         match self.core.authority(now_us) {
             Authority::Drive => {
-                physics.set_leg_targets(leg, &self.targets_rad);
+                physics.set_leg_targets(self.leg, &self.targets_rad);
                 physics.set_leg_enabled(leg, true);
             }
             Authority::TorqueOff => physics.set_leg_enabled(leg, false),
@@ -75,10 +68,7 @@ impl LegDrive {
 
     /// The feedback frame for the current state.
     pub fn feedback(&mut self, physics: &Physics) -> AnyMessage {
-        let first = 4 * self.leg as usize;
-        let pick = |all: [f64; 16]| -> [f32; 4] {
-            [0, 1, 2, 3].map(|j| all.get(first + j).copied().unwrap_or(0.0) as f32)
-        };
+        let pick = |all: Joints<f64>| -> [f32; 4] { all.leg(self.leg).map(|v| v as f32) };
         let efforts = if physics.leg_enabled(self.leg as usize) {
             pick(physics.leg_efforts_nm())
         } else {

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use mujoco_rs::prelude::MjModel;
 use mujoco_rs::wrappers::mj_model::MjtObjBase as MjtObj;
-use protocol::{JOINT_NAMES, WHEEL_NAMES};
+use protocol::{Joints, Leg, JOINT_NAMES, WHEEL_NAMES};
 
 /// The robot on flat ground, shipped with the crate.
 pub const DEFAULT_MODEL: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models/hybrid_robot.xml");
@@ -60,12 +60,12 @@ pub enum ModelError {
 /// Indices into MuJoCo's arrays for everything the hardware reads or drives.
 #[derive(Debug, Clone)]
 pub struct Layout {
-    /// `qpos` address of each leg joint, [`JOINT_NAMES`] order.
-    pub leg_qpos: [usize; 16],
+    /// `qpos` address of each leg joint.
+    pub leg_qpos: Joints<usize>,
     /// `qvel` address of each leg joint.
-    pub leg_qvel: [usize; 16],
+    pub leg_qvel: Joints<usize>,
     /// Actuator of each leg joint (`m_<joint>`).
-    pub leg_actuator: [usize; 16],
+    pub leg_actuator: Joints<usize>,
     /// Actuator group of each leg (FL, FR, BL, BR), for going torque-free.
     pub leg_group: [u32; 4],
     /// `qpos` address of each wheel joint (left, right).
@@ -75,7 +75,7 @@ pub struct Layout {
     /// Wheel actuators (`m_wheel_left`, `m_wheel_right`).
     pub wheel_actuator: [usize; 2],
     /// `sensordata` address of each leg actuator's force sensor.
-    pub leg_force_sensor: [usize; 16],
+    pub leg_force_sensor: Joints<usize>,
     /// `sensordata` address of each wheel actuator's force sensor.
     pub wheel_force_sensor: [usize; 2],
     /// `sensordata` addresses of the IMU: quaternion (4), gyro (3), accelerometer (3).
@@ -125,14 +125,14 @@ impl Layout {
         let qvel = |j: usize| model.jnt_dofadr()[j] as usize;
 
         let mut layout = Layout {
-            leg_qpos: [0; 16],
-            leg_qvel: [0; 16],
-            leg_actuator: [0; 16],
+            leg_qpos: Joints::splat(0),
+            leg_qvel: Joints::splat(0),
+            leg_actuator: Joints::splat(0),
             leg_group: [0; 4],
             wheel_qpos: [0; 2],
             wheel_qvel: [0; 2],
             wheel_actuator: [0; 2],
-            leg_force_sensor: [0; 16],
+            leg_force_sensor: Joints::splat(0),
             wheel_force_sensor: [0; 2],
             imu_quat: sensor("imu_quat")?,
             imu_gyro: sensor("imu_gyro")?,
@@ -142,17 +142,20 @@ impl Layout {
             wheel_geoms: [geom("wheel_left")?, geom("wheel_right")?],
             foot_geoms: [0; 4],
         };
-        for (i, name) in JOINT_NAMES.iter().enumerate() {
-            let j = joint(name)?;
-            layout.leg_qpos[i] = qpos(j);
-            layout.leg_qvel[i] = qvel(j);
-            layout.leg_actuator[i] = actuator(&format!("m_{name}"))?;
-            layout.leg_force_sensor[i] = sensor(&format!("frc_{name}"))?;
+        for (leg, names) in Joints::new(JOINT_NAMES).iter_legs() {
+            for (k, name) in names.iter().enumerate() {
+                let j = joint(name)?;
+                layout.leg_qpos.leg_mut(leg)[k] = qpos(j);
+                layout.leg_qvel.leg_mut(leg)[k] = qvel(j);
+                layout.leg_actuator.leg_mut(leg)[k] = actuator(&format!("m_{name}"))?;
+                layout.leg_force_sensor.leg_mut(leg)[k] = sensor(&format!("frc_{name}"))?;
+            }
         }
-        for (leg, suffix) in ["fl", "fr", "bl", "br"].into_iter().enumerate() {
-            layout.leg_group[leg] = model.actuator_group()[layout.leg_actuator[4 * leg]] as u32;
-            layout.foot_touch[leg] = sensor(&format!("touch_{suffix}"))?;
-            layout.foot_geoms[leg] = geom(&format!("foot_{suffix}"))?;
+        for leg in Leg::ALL {
+            let (i, suffix) = (leg as usize, leg.suffix());
+            layout.leg_group[i] = model.actuator_group()[layout.leg_actuator.leg(leg)[0]] as u32;
+            layout.foot_touch[i] = sensor(&format!("touch_{suffix}"))?;
+            layout.foot_geoms[i] = geom(&format!("foot_{suffix}"))?;
         }
         layout.check_leg_groups(model, path)?;
         let groups = model.actuator_group();
@@ -177,13 +180,15 @@ impl Layout {
     /// by disabling its group.
     fn check_leg_groups(&self, model: &MjModel, path: &Path) -> Result<(), ModelError> {
         let groups = model.actuator_group();
-        for (i, name) in JOINT_NAMES.iter().enumerate() {
-            let group = groups[self.leg_actuator[i]];
-            if group as u32 != self.leg_group[i / 4] || !(0..=30).contains(&group) {
-                return Err(ModelError::ActuatorGroups {
-                    path: path.to_owned(),
-                    detail: format!("m_{name} is in group {group}"),
-                });
+        for (leg, joints) in Joints::new(JOINT_NAMES).zip(self.leg_actuator).iter_legs() {
+            for (name, act) in joints {
+                let group = groups[*act];
+                if group as u32 != self.leg_group[leg as usize] || !(0..=30).contains(&group) {
+                    return Err(ModelError::ActuatorGroups {
+                        path: path.to_owned(),
+                        detail: format!("m_{name} is in group {group}"),
+                    });
+                }
             }
         }
         let mut distinct = self.leg_group.to_vec();

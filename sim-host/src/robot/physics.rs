@@ -6,6 +6,7 @@ use std::path::Path;
 
 use mujoco_rs::prelude::{MjData, MjModel};
 use mujoco_rs::wrappers::mj_model::MjtObjBase as MjtObj;
+use protocol::{Joints, Leg};
 
 use crate::robot::model::{load, Layout, ModelError};
 
@@ -117,7 +118,7 @@ impl Physics {
 
     /// Places the torso at `height_m` (level, at the origin, at rest) with the leg joints at
     /// `leg_joint_rad` and their servo targets there too.
-    pub fn place(&mut self, height_m: f64, leg_joint_rad: &[f64; 16]) {
+    pub fn place(&mut self, height_m: f64, leg_joint_rad: &Joints<f64>) {
         self.data.reset();
         let layout = self.layout.clone();
         {
@@ -133,11 +134,10 @@ impl Physics {
         self.data.forward();
     }
 
-    /// Sets the position target of every leg joint, rad ([`protocol::JOINT_NAMES`] order).
-    pub fn set_leg_targets(&mut self, leg: usize, targets_rad: &[f64; 4]) {
-        for (joint, target) in targets_rad.iter().enumerate() {
-            let act = self.layout.leg_actuator[4 * leg + joint];
-            self.data.ctrl_mut()[act] = *target;
+    /// Sets the position targets of `leg`'s four joints, rad (`hip1`, `hip2`, knee, ankle).
+    pub fn set_leg_targets(&mut self, leg: Leg, targets_rad: &[f64; 4]) {
+        for (act, target) in self.layout.leg_actuator.leg(leg).iter().zip(targets_rad) {
+            self.data.ctrl_mut()[*act] = *target;
         }
     }
 
@@ -166,17 +166,17 @@ impl Physics {
     }
 
     /// Leg joint angles, rad.
-    pub fn leg_positions_rad(&self) -> [f64; 16] {
+    pub fn leg_positions_rad(&self) -> Joints<f64> {
         self.layout.leg_qpos.map(|adr| self.data.qpos()[adr])
     }
 
     /// Leg joint velocities, rad/s.
-    pub fn leg_velocities_rad_s(&self) -> [f64; 16] {
+    pub fn leg_velocities_rad_s(&self) -> Joints<f64> {
         self.layout.leg_qvel.map(|adr| self.data.qvel()[adr])
     }
 
     /// Torque each leg servo applies, N·m.
-    pub fn leg_efforts_nm(&self) -> [f64; 16] {
+    pub fn leg_efforts_nm(&self) -> Joints<f64> {
         self.layout
             .leg_force_sensor
             .map(|adr| self.data.sensordata()[adr])

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use protocol::{AnyMessage, E2eCounter, EncodeError, Frame, Sync, Tick};
+use protocol::{AnyMessage, E2eCounter, EncodeError, Frame, Joints, Sync, Tick};
 
 use crate::output::telemetry::TelemetryRow;
 use crate::robot::hardware::Hardware;
@@ -17,8 +17,8 @@ use crate::robot::physics::Physics;
 pub struct StartPose {
     /// Torso centre height, m.
     pub height_m: f64,
-    /// Leg joint angles, [`protocol::JOINT_NAMES`] order, rad.
-    pub leg_joint_rad: [f64; 16],
+    /// Leg joint angles, rad.
+    pub leg_joint_rad: Joints<f64>,
 }
 
 impl StartPose {
@@ -32,13 +32,9 @@ impl StartPose {
             .stance(&config.geometry, &config.limits, depth_m)
             .map(|j| j.to_array())
             .unwrap_or([0.0; 4]);
-        let mut leg_joint_rad = [0.0; 16];
-        for (i, angle) in leg_joint_rad.iter_mut().enumerate() {
-            *angle = f64::from(leg[i % 4]);
-        }
         Self {
             height_m: f64::from(depth_m) + FOOT_RADIUS_M,
-            leg_joint_rad,
+            leg_joint_rad: Joints::from_leg_fn(|_| leg.map(f64::from)),
         }
     }
 }

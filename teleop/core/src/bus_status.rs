@@ -3,7 +3,9 @@
 //! traffic rate — and who has gone silent. Teleop decodes without sequence checks: it only
 //! listens, and a status it cannot decode is counted, not shown.
 
-use protocol::{decode_frame, AnyMessage, ControllerStatus, DriveFlags, Frame, RejectCounters};
+use protocol::{
+    decode_frame, AnyMessage, ControllerStatus, DriveFlags, Frame, PerDrive, RejectCounters,
+};
 
 /// A node is silent when nothing came from it for this long, ms (its status runs at 50 Hz;
 /// a drive's feedback at 250 Hz).
@@ -16,7 +18,7 @@ pub const RATE_WINDOW_MS: u64 = 1_000;
 pub struct BusStatus {
     controller: Option<(u64, ControllerStatus)>,
     wheel_speed_rad_s: Option<(u64, [f32; 2])>,
-    drives: [Option<(u64, DriveFlags)>; 5],
+    drives: PerDrive<Option<(u64, DriveFlags)>>,
     rejected: Option<RejectCounters>,
     last_feedback_ms: Option<u64>,
     undecodable: u64,
@@ -43,9 +45,7 @@ impl BusStatus {
                 self.last_feedback_ms = Some(now_ms)
             }
             AnyMessage::DriveStatus(drive, status) => {
-                if let Some(slot) = self.drives.get_mut(drive as usize) {
-                    *slot = Some((now_ms, status.flags));
-                }
+                *self.drives.get_mut(drive) = Some((now_ms, status.flags));
             }
             AnyMessage::RejectCounters(counters) => self.rejected = Some(counters),
             _ => {}
@@ -88,8 +88,8 @@ impl BusStatus {
         self.wheel_speed_rad_s.map(|(_, s)| s)
     }
 
-    /// Each drive's last flags (legs FL FR BL BR, wheels).
-    pub fn drive_flags(&self) -> [Option<DriveFlags>; 5] {
+    /// Each drive's last flags.
+    pub fn drive_flags(&self) -> PerDrive<Option<DriveFlags>> {
         self.drives.map(|d| d.map(|(_, f)| f))
     }
 
