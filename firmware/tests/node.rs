@@ -75,10 +75,10 @@ fn a_corrupted_frame_is_rejected_counted_and_never_applied() {
 }
 
 #[test]
-fn the_readmes_cansend_estop_latches_and_clears() {
+fn the_documented_cansend_estop_latches_and_clears() {
     let mut node = Node::new(Config::ROBOT).unwrap();
     // `cansend vcan0 000##129660000010A` (latch, counter 0) and `000##155B80100020A`
-    // (clear, counter 1) from the README.
+    // (clear, counter 1) from docs/protocol.md.
     let latch = [0x29, 0x66, 0x00, 0x00, 0x01, 0x0A];
     let clear = [0x55, 0xB8, 0x01, 0x00, 0x02, 0x0A];
     node.on_frame(Tick(0), 0x000, &latch).unwrap();

@@ -121,3 +121,24 @@ fn the_wall_clock_runs_in_real_time_and_reports_it() {
         assert!(started.elapsed() >= std::time::Duration::from_millis(990));
     }
 }
+
+#[test]
+fn the_old_imu_flag_names_still_work_for_one_release() {
+    for flags in [
+        [
+            "--gyro-noise-rad-s",
+            "--gyro-bias-rad-s",
+            "--accel-noise-m-s2",
+        ],
+        ["--gyro-noise", "--gyro-bias", "--accel-noise"],
+    ] {
+        let result = sim_host()
+            .args(["run", "--duration-s", "0.2", "--no-plots", "--out"])
+            .arg(scratch(flags[0].trim_start_matches('-')))
+            .args([flags[0], "0.01", flags[1], "0.001", flags[2], "0.05"])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert!(result.status.success(), "{flags:?}: {stderr}");
+    }
+}

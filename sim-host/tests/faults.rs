@@ -1,5 +1,5 @@
 //! The fault matrix, in-process and lockstep: every cell must hold. The table it prints is the
-//! one `cargo xtask faults` puts in the README.
+//! one `cargo xtask faults` puts in docs/faults.md.
 
 use std::path::Path;
 

@@ -32,11 +32,11 @@ pub struct InprocOptions {
 
 impl InprocOptions {
     /// The report's robot on flat ground in real time, for up to a day.
-    pub fn realtime() -> Self {
+    pub fn wall_clock() -> Self {
         Self {
             model: PathBuf::from(sim_host::robot::model::DEFAULT_MODEL),
             out_dir: None,
-            clock: Clock::Realtime,
+            clock: Clock::Wall,
             duration_s: 86_400.0,
         }
     }

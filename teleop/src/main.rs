@@ -227,7 +227,7 @@ fn conclude(report: &ScriptReport, bus: &str) -> Result<(), Failure> {
 #[cfg(feature = "sim")]
 fn inproc(cli: &Cli, scenario: Option<&Scenario>, stop: &AtomicBool) -> Result<(), Failure> {
     use teleop::inproc::{InprocOptions, InprocRobot};
-    let mut options = InprocOptions::realtime();
+    let mut options = InprocOptions::wall_clock();
     if let Some(model) = &cli.model {
         options.model = model.clone();
     }

@@ -141,7 +141,7 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
 
 #[test]
 fn in_real_time_the_key_reaches_the_actuators_within_about_a_period() {
-    let (robot, mut bus) = InprocRobot::start(InprocOptions::realtime());
+    let (robot, mut bus) = InprocRobot::start(InprocOptions::wall_clock());
     let start = Instant::now();
     let mut app = App::new("inproc");
     let settled = wait_for(
@@ -195,7 +195,7 @@ fn in_real_time_the_key_reaches_the_actuators_within_about_a_period() {
 
 #[test]
 fn when_the_operator_goes_silent_the_controller_stops_within_500_ms() {
-    let (robot, mut bus) = InprocRobot::start(InprocOptions::realtime());
+    let (robot, mut bus) = InprocRobot::start(InprocOptions::wall_clock());
     let start = Instant::now();
     let mut app = App::new("inproc");
     app.key(0, Key::Char('l'));

@@ -1,4 +1,4 @@
-//! Figures for the README and the closing note, measured where the suite runs (in the VM when
+//! Figures for docs/hil.md and the closing note, measured where the suite runs (in the VM when
 //! the host has no vcan): lockstep speed over vcan against the in-process bus, the bus load seen
 //! by candump against the protocol crate's computed load, and real-time control-period jitter
 //! and feedback-to-command latency from the kernel's frame timestamps. Each test also asserts

@@ -26,7 +26,10 @@ pub fn run(args: &[String]) -> Result<(), String> {
     let work = root().join("target").join("same-run");
     let old_bin = build_old(rev, &work)?;
     sh(cargo().args(["build", "--quiet", "-p", "sim-host"]))?;
-    let new_bin = root().join("target").join("debug").join("sim-host");
+    let new_bin = std::env::var_os("CARGO_TARGET_DIR")
+        .map_or_else(|| root().join("target"), PathBuf::from)
+        .join("debug")
+        .join("sim-host");
     let scenarios = scenarios()?;
     let mut differences = Vec::new();
     for scenario in &scenarios {
@@ -67,24 +70,28 @@ fn build_old(rev: &str, work: &Path) -> Result<PathBuf, String> {
         std::fs::remove_dir_all(&src).map_err(|e| format!("{}: {e}", src.display()))?;
     }
     std::fs::create_dir_all(&src).map_err(|e| format!("{}: {e}", src.display()))?;
-    let archive = Command::new("git")
+    let mut archive = Command::new("git")
         .args(["archive", "--format=tar", rev])
         .current_dir(root())
         .stdout(Stdio::piped())
         .spawn()
         .map_err(|e| format!("could not run git archive: {e}"))?;
-    let Some(tar_input) = archive.stdout else {
+    let Some(tar_input) = archive.stdout.take() else {
         return Err("git archive gave no output".into());
     };
-    let status = Command::new("tar")
+    let extracted = Command::new("tar")
         .args(["-x", "-C"])
         .arg(&src)
         .stdin(tar_input)
         .status()
         .map_err(|e| format!("could not run tar: {e}"))?;
-    if !status.success() {
+    let archived = archive
+        .wait()
+        .map_err(|e| format!("git archive did not finish: {e}"))?;
+    if !archived.success() || !extracted.success() {
         return Err(format!(
-            "could not extract {rev}: is it a revision of this repository? ({status})"
+            "could not extract `{rev}`: is it a revision of this repository? (git archive: \
+             {archived}, tar: {extracted})"
         ));
     }
     let target = work.join("target");

@@ -17,8 +17,8 @@ use host_can::socketcan_bus::SocketCanBus;
 /// The hybrid robot's firmware as a host process on a CAN interface.
 ///
 /// In lockstep mode it computes one control tick per SYNC frame from the simulator
-/// (`sim-host run --bus vcan0`); on the wall clock it keeps its own time at the control rate, as on
-/// the microcontroller. Ctrl-C or SIGTERM stops it after sending the drives a stop (legs
+/// (`sim-host run --bus vcan0`); on the wall clock it keeps its own time at the control rate, as
+/// on the microcontroller. Ctrl-C or SIGTERM stops it after sending the drives a stop (legs
 /// torque-free, zero wheel torque).
 ///
 /// Example: firmware-host --bus vcan0 --clock lockstep
@@ -86,7 +86,12 @@ fn main() -> ExitCode {
             .filter(|s| s.is_finite() && *s > 0.0)
             .map(Duration::from_secs_f64),
     };
-    tracing::info!(bus = %cli.bus, clock = ?cli.clock, control_hz = cli.control_hz, "firmware running");
+    tracing::info!(
+        bus = %cli.bus,
+        clock = ?cli.clock,
+        control_hz = cli.control_hz,
+        "firmware running"
+    );
     match runner::run(&mut bus, config, &stop) {
         Ok(stats) => {
             println!(

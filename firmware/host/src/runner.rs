@@ -21,12 +21,12 @@ use host_can::{Bus, BusError};
 use protocol::RejectCause;
 
 /// Most frames taken in one call of the service loop: a bound for a flooded bus, far above
-/// what one control period carries (a call that reaches it is simply followed by another, after
-/// the stop flag and the idle timeout are looked at).
-const RX_LIMIT: u32 = 256;
+/// what one control period carries (a call that reaches it is simply followed by another).
+/// 4096 frames are 0.4 s of a 10,000 frames/s flood.
+const RX_LIMIT: u32 = 4096;
 
-/// Lockstep: how long one wait for the simulator's next frame lasts before the runner looks at
-/// its stop flag and idle timeout again.
+/// Lockstep: how long one call of the service loop waits for the simulator's frames before the
+/// runner looks at its stop flag and idle timeout again.
 const LOCKSTEP_POLL: Duration = Duration::from_millis(50);
 
 /// How the runner keeps time.
@@ -119,7 +119,7 @@ fn lockstep(
     let mut next = Tick(0);
     let mut last_sync = Instant::now();
     while !done(&config, stats, stop) {
-        let mut port = BusPort::new(bus, Wait::PerFrame(LOCKSTEP_POLL));
+        let mut port = BusPort::new(bus, Wait::Until(Instant::now() + LOCKSTEP_POLL));
         let received = service::receive(node, next, &mut port, Drain::ThroughSync, RX_LIMIT)?;
         stats.frames_in += u64::from(received.frames);
         let Some(sync_tick) = received.sync_tick else {

@@ -1,4 +1,4 @@
-//! The runner answers SYNC with the firmware's commands, keeps time in timer mode, and stops
+//! The runner answers SYNC with the firmware's commands, keeps time on the wall clock, and stops
 //! the drives when it stops.
 
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -90,7 +90,7 @@ fn a_quiet_bus_in_lockstep_is_an_error_naming_the_simulator() {
 }
 
 #[test]
-fn timer_mode_keeps_its_own_time() {
+fn on_the_wall_clock_it_keeps_its_own_time() {
     let bus = InprocBus::new();
     let mut listener = bus.endpoint();
     let mut firmware_bus = bus.endpoint();
@@ -147,7 +147,7 @@ impl<B: Bus> Bus for StallingBus<B> {
 }
 
 #[test]
-fn a_stalled_timer_loses_the_missed_ticks_instead_of_bunching_them_up() {
+fn a_stalled_wall_clock_runner_loses_the_missed_ticks_instead_of_bunching_them_up() {
     let bus = InprocBus::new();
     let mut stalling = StallingBus {
         inner: bus.endpoint(),

@@ -90,7 +90,8 @@ pub struct Controller {
     drive_faults: PerDrive<bool>,
     tilted: bool,
     non_finite: bool,
-    /// Whether the node's link monitor finds the bus too lossy (see [`Controller::set_link_degraded`]).
+    /// Whether the node's link monitor finds the bus too lossy (see
+    /// [`Controller::set_link_degraded`]).
     link_degraded: bool,
     ik_failures: u32,
 }

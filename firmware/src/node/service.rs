@@ -48,10 +48,11 @@ pub struct Received {
 pub struct Transmitted {
     /// The tick's output (commands, status).
     pub output: Output,
-    /// Frames the port took.
+    /// Frames the port queued without losing another.
     pub sent: u32,
-    /// Frames lost: the port's queue stayed full for [`TX_TRIES`] tries, or a later frame of
-    /// higher priority took a queued one's place.
+    /// Frames lost: one whose queue stayed full for [`TX_TRIES`] tries, or, for one the port
+    /// queued in place of a lower-priority frame, the frame it displaced (either way one frame
+    /// of this node does not reach the bus).
     pub dropped: u32,
 }
 

@@ -1,7 +1,7 @@
 //! Differential drive: a wheel-speed PI loop that produces torque, saturated, with anti-windup.
 //!
-//! The balance law ([`crate::wheels::balance`]) owns the common mode (both wheels together: it must,
-//! since driving the wheels is how an inverted pendulum keeps its balance). This loop owns the
+//! The balance law ([`crate::wheels::balance`]) owns the common mode (both wheels together: it
+//! must, since driving the wheels is how an inverted pendulum keeps its balance). This loop owns the
 //! differential mode — half the speed difference of the wheels, which turns the robot — and
 //! [`mix`] combines the two into per-wheel torques.
 

@@ -1,5 +1,5 @@
 //! What paces a run: [`lockstep`] (the simulator is the clock and sends SYNC; deterministic,
-//! faster than real time) or [`realtime`] (the wall clock at the control rate).
+//! faster than real time) or [`wall`] (the wall clock at the control rate).
 
 pub mod lockstep;
-pub mod realtime;
+pub mod wall;

@@ -16,7 +16,7 @@ pub struct Summary<'a> {
     pub scenario: &'a str,
     /// Bus: `inproc` or an interface name.
     pub bus: &'a str,
-    /// `lockstep` or `realtime`.
+    /// `lockstep` or `wall`.
     pub clock: &'a str,
     /// Simulated time, s.
     pub simulated_s: f64,

@@ -10,7 +10,8 @@ use crate::output::output_error::OutputError;
 use crate::output::telemetry::TelemetryRow;
 
 /// The CSV's column names, in order: time, torso position and attitude, one `<joint>_rad`
-/// column per leg joint in [`JOINT_NAMES`] order, wheel torques and speeds, foot forces, body contact, controller mode.
+/// column per leg joint in [`JOINT_NAMES`] order, wheel torques and speeds, foot forces, body
+/// contact, controller mode.
 pub fn header() -> Vec<String> {
     let leading = [
         "time_s",

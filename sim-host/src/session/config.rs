@@ -29,7 +29,7 @@ pub enum Clock {
     /// The simulator is the clock (SYNC frames); as fast as possible.
     Lockstep,
     /// The wall clock at the control rate.
-    Realtime,
+    Wall,
 }
 
 /// Frames to render during a run (feature `renderer`): the model's `chase` camera, offscreen.

@@ -49,11 +49,12 @@ impl InprocController {
         let now = self.tick;
         let mut port = BusPort::new(&mut self.bus, Wait::Never);
         let received = service::receive(&mut self.node, now, &mut port, Drain::All, RX_LIMIT)?;
-        let sent = service::transmit(&mut self.node, now, &mut port)?;
         self.rejected += u64::from(received.rejected);
         if let Some(tick) = received.sync_tick {
             self.watch_sync(tick);
         }
+        let mut port = BusPort::new(&mut self.bus, Wait::Never);
+        let sent = service::transmit(&mut self.node, now, &mut port)?;
         self.last_output = Some(sent.output);
         self.tick = now.plus(1);
         Ok(())

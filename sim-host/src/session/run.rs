@@ -14,7 +14,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use teleop_core::scripted::ScriptedTeleop;
 
 use crate::clock::lockstep::{self, LockstepOptions};
-use crate::clock::realtime::{self, RealtimeOptions};
+use crate::clock::wall::{self, WallOptions};
 use crate::output::metrics::{BusCounters, SegmentSummary};
 use crate::output::output_error::OutputError;
 use crate::output::recorder::Recorder;
@@ -66,11 +66,12 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
     let mut files = Vec::new();
     let mut recorder = open_recorder(config, &mut files)?;
     let counters: FirmwareCounters = Rc::new(Cell::new(Default::default()));
+    let watch = Watch::open(config, &sim)?;
     let mut observer = Observer {
         config,
         segments: Segments::new(&config.segments),
         progress: progress_bar(config.progress, cycles),
-        watch: Watch::open(config, &sim)?,
+        watch,
         watch_error: None,
         interrupted: false,
         counters: Rc::clone(&counters),
@@ -235,11 +236,11 @@ fn drive(
             peers,
             observe,
         ),
-        Clock::Realtime => realtime::run(
+        Clock::Wall => wall::run(
             sim,
             bus,
             recorder,
-            RealtimeOptions {
+            WallOptions {
                 cycles,
                 period: Duration::from_secs_f64(1.0 / f64::from(config.control_hz.max(1))),
             },

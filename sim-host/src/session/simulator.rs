@@ -1,6 +1,6 @@
 //! The simulated robot: MuJoCo physics plus the emulated CAN nodes, advanced one control cycle
-//! at a time. Bus- and clock-agnostic: [`crate::clock::lockstep`] and [`crate::clock::realtime`] move frames
-//! between it and a [`host_can::bus::Bus`].
+//! at a time. Bus- and clock-agnostic: [`crate::clock::lockstep`] and [`crate::clock::wall`]
+//! move frames between it and a [`host_can::bus::Bus`].
 
 use std::path::Path;
 

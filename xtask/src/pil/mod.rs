@@ -1,8 +1,8 @@
 //! `cargo xtask pil [--record]`: processor-in-the-loop on an emulated Cortex-M4F.
 //!
 //! The control core (`firmware/pil`, the same `Node` and service loop,
-//! `firmware::node::service`, as the STM32 image) runs in QEMU's `mps2-an386` with `-icount shift=0` against the frames the firmware
-//! received in a recorded closed-loop run (`firmware/pil/recording.pil`), and this task checks
+//! `firmware::node::service`, as the STM32 image) runs in QEMU's `mps2-an386` with
+//! `-icount shift=0` against the frames the firmware received in a recorded closed-loop run (`firmware/pil/recording.pil`), and this task checks
 //! that every frame it sends equals, field by field, what the host build of the core sends for
 //! the same inputs (fixed-point fields within one count: the float maths may round differently;
 //! enumerations, flags and counters exactly). It prints the instructions per control step

@@ -91,7 +91,7 @@ pub(crate) struct RunArgs {
     pub(crate) gyro_bias_rad_s: f64,
     /// IMU accelerometer white noise, standard deviation, m/s² (`--accel-noise`: the old name).
     #[arg(long, default_value_t = 0.0, alias = "accel-noise")]
-    accel_noise_m_s2: f64,
+    pub(crate) accel_noise_m_s2: f64,
     /// Seed of the IMU noise.
     #[arg(long, default_value_t = 1)]
     pub(crate) seed: u64,
@@ -205,7 +205,7 @@ fn session_config(args: &RunArgs, scenario: Option<&Scenario>, duration_s: f64) 
         bus,
         clock: match args.clock {
             ClockArg::Lockstep => Clock::Lockstep,
-            ClockArg::Wall => Clock::Realtime,
+            ClockArg::Wall => Clock::Wall,
         },
         duration_s,
         control_hz: args.control_hz,

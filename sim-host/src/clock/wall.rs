@@ -12,7 +12,7 @@ use host_can::bus::Bus;
 
 /// Real-time settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct RealtimeOptions {
+pub struct WallOptions {
     /// Control cycles to run.
     pub cycles: u64,
     /// Length of a cycle on the wall clock.
@@ -20,12 +20,13 @@ pub struct RealtimeOptions {
 }
 
 /// Runs `options.cycles` cycles on the wall clock. `peers(cycle)` runs right after the
-/// simulator has sent its feedback (see [`crate::clock::lockstep::run`]); `observe` after each cycle.
+/// simulator has sent its feedback (see [`crate::clock::lockstep::run`]); `observe` after each
+/// cycle.
 pub fn run(
     sim: &mut Simulator,
     bus: &mut dyn Bus,
     recorder: &mut Recorder,
-    options: RealtimeOptions,
+    options: WallOptions,
     mut peers: impl FnMut(u32) -> Result<(), RunError>,
     mut observe: impl FnMut(&Simulator, &RunStats) -> bool,
 ) -> Result<RunStats, RunError> {
