@@ -351,3 +351,14 @@ pub fn wait_for_log(
     }
     false
 }
+
+/// A test that measures timing holds this for its whole run, so that the tests of its file run
+/// one at a time: in an emulated VM a second closed loop beside it would starve the simulator
+/// and the firmware of CPU and skew the figure (a test binary is one process, so this orders
+/// the tests of one file).
+pub fn one_at_a_time() -> std::sync::MutexGuard<'static, ()> {
+    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    ONE_AT_A_TIME
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}

@@ -3,12 +3,11 @@
 //! flooding the bus, and the firmware killed with SIGKILL. Judged from `candump -L` (every frame
 //! as the kernel carried it), the simulator's telemetry and summary.
 
-use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use hil_tests::{
-    candump, candump_filtered, firmware, out_dir, read_candump, read_telemetry, scenario, simulate,
-    start_sim, wait_for_log, Process, Vcan,
+    candump, candump_filtered, firmware, one_at_a_time, out_dir, read_candump, read_telemetry,
+    scenario, simulate, start_sim, wait_for_log, Process, Vcan,
 };
 use host_can::bus::Bus;
 use host_can::fault_plan::Faults;
@@ -18,16 +17,6 @@ use protocol::{
     decode_frame, AnyMessage, BodyHeight, ControllerMode, FaultFlags, Frame, MessageId, Millis,
     NodeId, Receiver, RejectCause, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode,
 };
-
-/// The tests of this file run one at a time: the flood test measures timing, and in an emulated
-/// VM a second closed loop beside it would starve both simulator and firmware of CPU.
-static ONE_AT_A_TIME: Mutex<()> = Mutex::new(());
-
-fn alone() -> MutexGuard<'static, ()> {
-    ONE_AT_A_TIME
-        .lock()
-        .unwrap_or_else(|poisoned| poisoned.into_inner())
-}
 
 /// Whether the controller sent `frame`.
 fn from_controller(frame: &Frame) -> bool {
@@ -54,7 +43,7 @@ fn segment_fell(summary: &serde_json::Value) -> bool {
 
 #[test]
 fn corrupted_and_replayed_feedback_over_vcan_is_refused_frame_for_frame_and_the_trot_goes_on() {
-    let _alone = alone();
+    let _alone = one_at_a_time();
     let bus = Vcan::new();
     let log = out_dir("faults-e2e").with_extension("log");
     let dump = candump(&bus, &log);
@@ -118,7 +107,7 @@ fn corrupted_and_replayed_feedback_over_vcan_is_refused_frame_for_frame_and_the_
 
 #[test]
 fn twenty_percent_loss_over_vcan_brings_the_robot_to_a_safe_stop() {
-    let _alone = alone();
+    let _alone = one_at_a_time();
     let bus = Vcan::new();
     let log = out_dir("faults-loss").with_extension("log");
     let dump = candump(&bus, &log);
@@ -215,7 +204,7 @@ fn flood(ifname: &str, rate_hz: f64, seconds: f64) -> u64 {
 
 #[test]
 fn a_10000_frames_per_second_teleop_flood_leaves_the_control_period_and_feedback_alone() {
-    let _alone = alone();
+    let _alone = one_at_a_time();
     let bus = Vcan::new();
     let log = out_dir("faults-flood").with_extension("log");
     // Everything but the flood itself: its frames are counted where they are made.
@@ -353,7 +342,7 @@ fn a_10000_frames_per_second_teleop_flood_leaves_the_control_period_and_feedback
 
 #[test]
 fn a_killed_firmware_leaves_the_drives_torque_free_within_100_ms_and_they_say_timed_out() {
-    let _alone = alone();
+    let _alone = one_at_a_time();
     let bus = Vcan::new();
     let log = out_dir("faults-kill").with_extension("log");
     let dump = candump(&bus, &log);

@@ -7,7 +7,8 @@
 use std::time::Duration;
 
 use hil_tests::{
-    candump, firmware, out_dir, read_candump, scenario, simulate, start_sim, Process, Vcan,
+    candump, firmware, one_at_a_time, out_dir, read_candump, scenario, simulate, start_sim,
+    Process, Vcan,
 };
 use protocol::busload::{bus_load, fd_frame_bits, ROBOT_BUS};
 use protocol::MessageId;
@@ -18,6 +19,7 @@ fn steps_per_s(summary: &serde_json::Value) -> f64 {
 
 #[test]
 fn lockstep_over_vcan_keeps_at_least_half_the_in_process_speed() {
+    let _alone = one_at_a_time();
     let w = scenario("w.toml");
     let inproc_out = out_dir("speed-inproc");
     let status =
@@ -40,6 +42,7 @@ fn lockstep_over_vcan_keeps_at_least_half_the_in_process_speed() {
 
 #[test]
 fn the_bus_load_candump_sees_matches_the_computed_schedule() {
+    let _alone = one_at_a_time();
     let bus = Vcan::new();
     let log = out_dir("load").with_extension("log");
     let dump = candump(&bus, &log);
@@ -85,6 +88,7 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
 
 #[test]
 fn real_time_control_period_jitter_and_feedback_to_command_latency() {
+    let _alone = one_at_a_time();
     let bus = Vcan::new();
     let log = out_dir("jitter").with_extension("log");
     let dump = candump(&bus, &log);
