@@ -1,16 +1,21 @@
 //! can-utils, which this project did not write, on the same bus: `cansend` stops the robot,
 //! `candump -L` records a bus every frame of which decodes.
+//!
+//! The tests run one at a time: the canplayer test replays a recording on the wall clock into a
+//! lockstep simulator, so its record and replay must run at the same pace, which a second closed
+//! loop beside either (in an emulated VM) would break.
 
 use std::time::Duration;
 
 use hil_tests::{
-    candump, cansend, firmware, out_dir, read_candump, read_telemetry, start_sim, wait_for_log,
-    workspace, Process, Vcan,
+    candump, cansend, firmware, one_at_a_time, out_dir, read_candump, read_telemetry, start_sim,
+    wait_for_log, workspace, Process, Vcan,
 };
 use protocol::{decode_frame, AnyMessage, ControllerMode, EStop, EStopAction, NodeId};
 
 #[test]
 fn an_e_stop_from_cansend_stops_every_drive_within_one_control_period() {
+    let _alone = one_at_a_time();
     let bus = Vcan::new();
     let fw = firmware(&bus);
     let out = out_dir("estop");
@@ -81,6 +86,7 @@ fn an_e_stop_from_cansend_stops_every_drive_within_one_control_period() {
 
 #[test]
 fn candump_records_a_bus_on_which_every_frame_decodes() {
+    let _alone = one_at_a_time();
     let bus = Vcan::new();
     let fw = firmware(&bus);
     let log = out_dir("dump").with_extension("log");
@@ -161,6 +167,7 @@ fn lockstep_pair(bus: &Vcan, out: &std::path::Path, extra: &[&str]) -> (Process,
 
 #[test]
 fn canplayer_replays_a_recorded_teleop_session_and_the_robot_repeats_it() {
+    let _alone = one_at_a_time();
     // Record: a scripted operator folds and drives forward; candump records the bus.
     let first = Vcan::new();
     let log = out_dir("session").with_extension("log");
@@ -263,6 +270,7 @@ impl PacedRobot {
 
 #[test]
 fn a_teleop_command_from_cansend_folds_the_robot_onto_its_wheels() {
+    let _alone = one_at_a_time();
     // Once the controller reports (it stands in Stop), send `fold` from a shell.
     let robot = PacedRobot::start("teleop", "8");
     let fold = AnyMessage::TeleopCommand(protocol::TeleopCommand {
@@ -295,6 +303,7 @@ fn a_teleop_command_from_cansend_folds_the_robot_onto_its_wheels() {
 
 #[test]
 fn teleop_send_from_a_script_folds_the_robot_and_the_controller_stops_when_it_quits() {
+    let _alone = one_at_a_time();
     let robot = PacedRobot::start("script", "8");
     let teleop = Process::start(
         "teleop",
@@ -347,6 +356,7 @@ fn teleop_send_from_a_script_folds_the_robot_and_the_controller_stops_when_it_qu
 
 #[test]
 fn teleop_script_drives_the_robot_and_a_bus_without_controller_exits_3() {
+    let _alone = one_at_a_time();
     let robot = PacedRobot::start("teleop-script", "10");
     let script = workspace().join("scenarios/teleop_drive.toml");
     let teleop = Process::start(
