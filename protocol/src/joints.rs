@@ -8,7 +8,7 @@
 //! [`Drive::ALL`] order, and both are read by [`Leg`] or [`Drive`] rather than by a number.
 //!
 //! Neither type knows a unit: the fields and variables that hold them name it
-//! (`leg_targets_rad: Joints<f32>`, `efforts_nm: Joints<f64>`), as everywhere in the project.
+//! (`leg_targets_rad: Joints<f32>`, the simulator's `efforts_nm`), as everywhere in the project.
 //!
 //! No accessor panics: per-leg and per-drive access is total (every [`Leg`] and [`Drive`] has
 //! its slot), access by a raw index returns an `Option` ([`Joints::get`]), and neither type
