@@ -247,3 +247,28 @@ fn a_babbling_teleop_does_not_hide_a_lossy_bus() {
             > 0
     );
 }
+
+#[test]
+fn loss_in_bursts_longer_than_the_sequence_window_is_measured_too() {
+    // Each identifier loses 12 frames in a row out of every 60 (20 %): every burst is longer
+    // than the receiver's 10-frame window, so the frame after it is refused as out of
+    // sequence and the next one resynchronises. The loss must count all the same.
+    let mut node = Node::new(CONFIG).unwrap();
+    let joints = common::standing_joints_rad(&CONFIG);
+    let mut counters: HashMap<u16, u16> = HashMap::new();
+    for now in 0..ticks_from_s(2) {
+        for message in common::plant_feedback(&joints) {
+            let counter = counters.entry(message.id().raw()).or_insert(0);
+            let frame = message.encode(*counter).unwrap();
+            *counter = counter.wrapping_add(1);
+            if *counter % 60 >= 12 {
+                let _ = node.on_frame(Tick(now), frame.id(), frame.data());
+            }
+        }
+        node.poll(Tick(now));
+    }
+    let loss = node.link().last_loss_permille().unwrap();
+    assert!((150..=250).contains(&loss), "measured {loss} ‰ of 200");
+    assert!(node.link().degraded());
+    assert!(node.reject_counters().get(RejectCause::WrongSequence).raw() > 0);
+}

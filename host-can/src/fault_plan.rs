@@ -7,6 +7,7 @@
 //! | item               | meaning                                                                |
 //! |--------------------|------------------------------------------------------------------------|
 //! | `D.drop=P`         | drop each frame with probability `P` (0…1)                             |
+//! | `D.burst=N`        | with `drop`: lose whole control cycles in bursts of `N` on average, `P` of the cycles in the long run (a Gilbert–Elliott channel) |
 //! | `D.delay=N`        | deliver every frame `N` control cycles late (order kept)               |
 //! | `D.duplicate=P`    | send a frame twice with probability `P`                                |
 //! | `D.reorder=P`      | hold a frame back behind the next one with probability `P`             |
@@ -17,18 +18,26 @@
 //! | `seed=S`           | the random generator's seed (default 1): runs are repeatable           |
 //!
 //! `D` is `tx` (frames this node sends) or `rx` (frames it receives). SYNC, the simulator's
-//! clock, is never faulted: it stands for time itself, which a bus cannot lose.
+//! clock, is never faulted: it stands for time itself, which a bus cannot lose. Counts of cycles
+//! and frames are at most [`MAX_CYCLES`] (a delay holds every frame in memory meanwhile).
 
 use std::fmt;
 use std::str::FromStr;
 
 use protocol::{Drive, MessageId, NodeId};
 
+/// Largest `delay`, `burst` and `flood`: 1,000 cycles are 4 s at 250 Hz, and a delay keeps
+/// every frame of that span in memory.
+pub const MAX_CYCLES: u32 = 1000;
+
 /// The faults of one direction.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct FaultPlan {
-    /// Probability of dropping a frame, 0…1.
+    /// Probability of dropping a frame, 0…1; with [`FaultPlan::burst_cycles`], the long-run
+    /// fraction of control cycles lost.
     pub drop: f64,
+    /// Mean length of a loss burst, control cycles (0: frames are dropped independently).
+    pub burst_cycles: u32,
     /// Control cycles every frame is held back.
     pub delay_cycles: u32,
     /// Probability of sending a frame twice, 0…1.
@@ -85,7 +94,7 @@ pub enum FaultPlanError {
     Direction(String),
     /// The fault is unknown.
     #[error(
-        "`{0}`: unknown fault; use drop, delay, duplicate, reorder, flip, replay, silence or flood"
+        "`{0}`: unknown fault; use drop, burst, delay, duplicate, reorder, flip, replay, silence or flood"
     )]
     UnknownFault(String),
     /// A probability outside 0…1 or not a number.
@@ -94,6 +103,9 @@ pub enum FaultPlanError {
     /// A count that is not a whole number.
     #[error("`{0}`: needs a whole number")]
     Count(String),
+    /// A count above [`MAX_CYCLES`].
+    #[error("`{0}`: at most {MAX_CYCLES}")]
+    TooLarge(String),
     /// A node name nobody has.
     #[error("`{0}`: unknown node; use one of {names} or `feedback`", names = node_names())]
     Node(String),
@@ -146,14 +158,15 @@ impl FromStr for Faults {
                     .filter(|p| (0.0..=1.0).contains(p))
                     .ok_or_else(|| FaultPlanError::Probability(item.to_owned()))
             };
-            let count = || {
-                value
-                    .parse::<u32>()
-                    .map_err(|_| FaultPlanError::Count(item.to_owned()))
+            let count = || match value.parse::<u32>() {
+                Ok(n) if n <= MAX_CYCLES => Ok(n),
+                Ok(_) => Err(FaultPlanError::TooLarge(item.to_owned())),
+                Err(_) => Err(FaultPlanError::Count(item.to_owned())),
             };
             match fault {
                 "drop" => plan.drop = probability()?,
                 "delay" => plan.delay_cycles = count()?,
+                "burst" => plan.burst_cycles = count()?,
                 "duplicate" => plan.duplicate = probability()?,
                 "reorder" => plan.reorder = probability()?,
                 "flip" => plan.flip = probability()?,
@@ -189,6 +202,9 @@ impl fmt::Display for Faults {
                     items.push(format!("{direction}.{name}={p}"));
                 }
             }
+            if plan.burst_cycles > 0 {
+                items.push(format!("{direction}.burst={}", plan.burst_cycles));
+            }
             if plan.delay_cycles > 0 {
                 items.push(format!("{direction}.delay={}", plan.delay_cycles));
             }
@@ -223,11 +239,12 @@ mod tests {
     #[test]
     fn reads_every_fault_and_writes_it_back() {
         let text = "tx.drop=0.05,rx.delay=3,tx.flip=0.01,rx.replay=0.2,tx.duplicate=0.1,\
-                    rx.reorder=0.3,tx.flood=40,tx.silence=Imu,seed=7";
+                    rx.reorder=0.3,tx.flood=40,tx.silence=Imu,rx.drop=0.2,rx.burst=5,seed=7";
         let faults: Faults = text.parse().unwrap();
         assert_eq!(faults.tx.drop, 0.05);
         assert_eq!(faults.rx.delay_cycles, 3);
         assert_eq!(faults.tx.flood_per_cycle, 40);
+        assert_eq!(faults.rx.burst_cycles, 5);
         assert_eq!(faults.tx.silence, [NodeId::Imu]);
         assert_eq!(faults.seed, 7);
         assert_eq!(faults.to_string().parse::<Faults>().unwrap(), faults);
@@ -250,6 +267,9 @@ mod tests {
             ("tx.drop=1.5", "probability"),
             ("tx.drop=x", "probability"),
             ("rx.delay=-1", "whole number"),
+            ("rx.delay=4294967295", "at most 1000"),
+            ("tx.burst=1001", "at most 1000"),
+            ("tx.flood=100000", "at most 1000"),
             ("tx.silence=Toaster", "unknown node"),
             ("seed=abc", "whole number"),
         ];

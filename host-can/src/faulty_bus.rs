@@ -62,6 +62,8 @@ struct Injector {
     replayed_last: Vec<u16>,
     flood_template: Option<AnyMessage>,
     flood_counter: Option<E2eCounter>,
+    /// With [`FaultPlan::burst_cycles`]: whether this cycle is inside a loss burst.
+    in_burst: bool,
     stats: FaultStats,
     /// Per id: frames sent that any receiver must reject (flipped, duplicated, replayed).
     bad_by_id: BTreeMap<u16, u64>,
@@ -78,6 +80,7 @@ impl Injector {
             replayed_last: Vec::new(),
             flood_template: None,
             flood_counter: None,
+            in_burst: false,
             stats: FaultStats::default(),
             bad_by_id: BTreeMap::new(),
         }
@@ -102,7 +105,12 @@ impl Injector {
         }
         let original = frame;
         self.remember(original);
-        if self.chance(self.plan.drop) {
+        let lost = if self.plan.burst_cycles == 0 {
+            self.chance(self.plan.drop)
+        } else {
+            self.in_burst
+        };
+        if lost {
             self.stats.dropped += 1;
             return;
         }
@@ -169,6 +177,24 @@ impl Injector {
         if let Some(held) = self.held.take() {
             self.queue
                 .push_back((cycle + u64::from(self.plan.delay_cycles), held));
+        }
+        self.next_burst_state();
+    }
+
+    /// The Gilbert–Elliott channel of [`FaultPlan::burst_cycles`]: a burst ends after each cycle
+    /// with probability 1/N, so bursts last N cycles on average, and one starts with the
+    /// probability that makes `drop` the long-run fraction of cycles inside one.
+    fn next_burst_state(&mut self) {
+        let p = self.plan.drop;
+        if self.plan.burst_cycles == 0 || p <= 0.0 {
+            return;
+        }
+        let n = f64::from(self.plan.burst_cycles);
+        if self.in_burst {
+            self.in_burst = !self.chance(1.0 / n);
+        } else {
+            let start = if p >= 1.0 { 1.0 } else { p / (n * (1.0 - p)) };
+            self.in_burst = self.chance(start);
         }
     }
 

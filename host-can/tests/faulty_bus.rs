@@ -76,6 +76,33 @@ fn drops_about_the_planned_share_and_never_the_sync() {
 }
 
 #[test]
+fn burst_loss_drops_whole_runs_of_cycles_at_the_planned_share() {
+    let (mut faulty, mut other) = rig("tx.drop=0.2,tx.burst=5,seed=3");
+    let cycles = 10_000_u32;
+    let got = run(&mut faulty, &mut other, cycles);
+    let received: std::collections::BTreeSet<u16> = got
+        .iter()
+        .filter(|f| f.id() == command(0).id())
+        .map(|f| u16::from_le_bytes([f.data()[2], f.data()[3]]))
+        .collect();
+    let lost: Vec<bool> = (1..=cycles)
+        .map(|c| !received.contains(&(c as u16)))
+        .collect();
+    let dropped = lost.iter().filter(|&&l| l).count();
+    let runs = lost.windows(2).filter(|w| !w[0] && w[1]).count() + usize::from(lost[0]);
+    let mean_run = dropped as f64 / runs.max(1) as f64;
+    assert_eq!(dropped as u64, faulty.tx_stats().dropped);
+    assert!(
+        (1600..2400).contains(&dropped),
+        "dropped {dropped} of {cycles}"
+    );
+    assert!(
+        (4.0..6.0).contains(&mean_run),
+        "bursts of {mean_run:.2} cycles"
+    );
+}
+
+#[test]
 fn delay_holds_frames_for_whole_cycles_in_order() {
     let (mut faulty, mut other) = rig("tx.delay=3");
     let mut arrival = Vec::new();

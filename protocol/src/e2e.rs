@@ -156,6 +156,31 @@ impl E2eChecker {
         status
     }
 
+    /// How many frames a sender skipped if `counter` jumps ahead of the sequence beyond the
+    /// tolerated window (a burst of loss longer than the window): counted from the last
+    /// accepted counter, or from a pending out-of-window one it continues after. `None` for a
+    /// counter in the window (see [`E2eStatus::OkSomeLost`]), a repeat, or one behind (half the
+    /// counter range or more ahead counts as behind: stale, replayed or reordered, not lost).
+    pub fn skipped_ahead(&self, counter: u16) -> Option<u16> {
+        const HALF: u16 = 0x8000;
+        let last = self.last?;
+        let ahead_of_last = |delta: u16| delta > self.max_delta && delta < HALF;
+        if let Some(candidate) = self
+            .candidate
+            .filter(|candidate| candidate.wrapping_sub(last) < HALF)
+        {
+            match counter.wrapping_sub(candidate) {
+                // Continues the pending counter: the sequence resynchronises, nothing skipped.
+                1 => return None,
+                delta if (2..HALF).contains(&delta) => return Some(delta - 1),
+                _ => {}
+            }
+        }
+        Some(counter.wrapping_sub(last))
+            .filter(|delta| ahead_of_last(*delta))
+            .map(|delta| delta - 1)
+    }
+
     fn accept(&mut self, counter: u16) {
         self.last = Some(counter);
         self.candidate = None;

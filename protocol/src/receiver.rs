@@ -77,7 +77,16 @@ impl Receiver {
             .checkers
             .get_mut(decoded.id.index())
             .ok_or(DecodeError::UnknownId(raw_id))?;
+        let skipped = checker.skipped_ahead(decoded.counter);
         let status = checker.check_counter(decoded.counter);
+        if status == E2eStatus::WrongSequence {
+            // A burst of loss longer than the window: the frames are lost all the same, and
+            // the link's loss must count them (the frame itself is refused until the
+            // sequence resynchronises on the next one).
+            if let Some(lost) = skipped {
+                self.counters.record_lost(lost);
+            }
+        }
         let fail_safe = matches!(
             decoded.message,
             AnyMessage::EStop(EStop {

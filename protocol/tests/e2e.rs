@@ -119,3 +119,58 @@ fn too_short_messages_are_never_verified() {
     assert_eq!(verify(0, &[]), None);
     assert_eq!(verify(0, &[1, 2, 3]), None);
 }
+
+#[test]
+fn a_jump_past_the_window_names_the_frames_skipped_and_a_step_back_none() {
+    let mut checker = checker_after(&[10]);
+    assert_eq!(checker.skipped_ahead(11), None, "in sequence");
+    assert_eq!(
+        checker.skipped_ahead(13),
+        None,
+        "inside the window: OkSomeLost counts it"
+    );
+    assert_eq!(checker.skipped_ahead(10), None, "a repeat");
+    assert_eq!(
+        checker.skipped_ahead(5),
+        None,
+        "behind: stale or replayed, not lost"
+    );
+    assert_eq!(checker.skipped_ahead(10u16.wrapping_sub(20)), None);
+    assert_eq!(checker.skipped_ahead(30), Some(19));
+    assert_eq!(checker.check_counter(30), E2eStatus::WrongSequence);
+    // A second jump counts from the pending one, so no frame is counted twice.
+    assert_eq!(checker.skipped_ahead(40), Some(9));
+    assert_eq!(checker.check_counter(40), E2eStatus::WrongSequence);
+    assert_eq!(
+        checker.skipped_ahead(41),
+        None,
+        "the sequence resynchronises here"
+    );
+    assert_eq!(checker.check_counter(41), E2eStatus::Initial);
+}
+
+#[test]
+fn the_receiver_counts_frames_skipped_by_a_long_burst_as_lost() {
+    let mut receiver = protocol::Receiver::default();
+    let sync = |counter: u16| {
+        protocol::AnyMessage::Sync(protocol::Sync {
+            tick: protocol::Tick::from_raw(u32::from(counter)).unwrap(),
+        })
+        .encode(counter)
+        .unwrap()
+    };
+    for counter in [0, 1, 2] {
+        let frame = sync(counter);
+        receiver.receive(frame.id(), frame.data()).unwrap();
+    }
+    // 30 frames lost in one burst (beyond the 10-frame window), then the sender goes on.
+    let frame = sync(33);
+    assert!(receiver.receive(frame.id(), frame.data()).is_err());
+    let frame = sync(34);
+    assert!(receiver.receive(frame.id(), frame.data()).is_ok());
+    assert_eq!(receiver.counters().lost.raw(), 30);
+    // A replay of an old frame is refused and counts no loss.
+    let frame = sync(1);
+    assert!(receiver.receive(frame.id(), frame.data()).is_err());
+    assert_eq!(receiver.counters().lost.raw(), 30);
+}

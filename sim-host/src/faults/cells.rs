@@ -46,11 +46,18 @@ pub(super) fn keeps_going(
     })
 }
 
-pub(super) fn safe_stop_on_loss(model: &Path, motion: Motion) -> Result<CellResult, SessionError> {
+/// 20 % loss from 2 s, each frame on its own or (`burst_cycles > 0`) whole control cycles in
+/// bursts of that many on average: either way the link monitor must stop the robot.
+pub(super) fn safe_stop_on_loss(
+    model: &Path,
+    motion: Motion,
+    burst_cycles: u32,
+) -> Result<CellResult, SessionError> {
     let start_s = 2.0;
     let plan = both(
         FaultPlan {
             drop: 0.2,
+            burst_cycles,
             ..FaultPlan::default()
         },
         3,
@@ -73,7 +80,10 @@ pub(super) fn safe_stop_on_loss(model: &Path, motion: Motion) -> Result<CellResu
         None => format!("did not stop; max tilt {:.1}°", max_tilt_deg(after)),
     };
     Ok(CellResult {
-        name: format!("{}, loss 20% from 2 s", motion.name()),
+        name: match burst_cycles {
+            0 => format!("{}, loss 20% from 2 s", motion.name()),
+            n => format!("{}, loss 20% in {n}-cycle bursts from 2 s", motion.name()),
+        },
         fault: plan.to_string(),
         expected: "degrades to a safe stop, no fall",
         measured,

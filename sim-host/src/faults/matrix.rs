@@ -142,7 +142,9 @@ pub fn run(model: &Path) -> Result<Vec<CellResult>, SessionError> {
             let what = format!("loss {:.0}%", p * 100.0);
             cells.push(keeps_going(model, motion, &what, &plan, base_m)?);
         }
-        cells.push(safe_stop_on_loss(model, motion)?);
+        cells.push(safe_stop_on_loss(model, motion, 0)?);
+        // 5 cycles are 20 ms at 250 Hz.
+        cells.push(safe_stop_on_loss(model, motion, 5)?);
         for delay in 1..=3 {
             let plan = both(
                 FaultPlan {
