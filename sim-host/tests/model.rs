@@ -127,3 +127,32 @@ fn a_broken_model_file_is_an_error_naming_the_file_and_line() {
     assert!(matches!(err, ModelError::Missing { .. }), "{err:?}");
     assert!(err.to_string().contains("no_robot.xml"), "{err}");
 }
+
+#[test]
+fn a_sensor_with_the_wrong_size_or_a_joint_without_range_is_named() {
+    let dir = std::env::temp_dir().join(format!("sim-host-model-sizes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let robot = std::fs::read_to_string(sim_host::robot::model::DEFAULT_MODEL).unwrap();
+    // The IMU's orientation as a 3-value sensor: the hardware reads 4 (a quaternion).
+    let three = robot.replace(
+        r#"<framequat name="imu_quat" objtype="site" objname="imu"/>"#,
+        r#"<framepos name="imu_quat" objtype="site" objname="imu"/>"#,
+    );
+    assert_ne!(three, robot, "the model's IMU quaternion sensor moved");
+    let path = dir.join("imu_quat_3.xml");
+    std::fs::write(&path, three).unwrap();
+    let err = Physics::load(&path).unwrap_err();
+    assert!(
+        matches!(&err, ModelError::SensorSize { name, expected: 4, found: 3, .. } if name == "imu_quat"),
+        "{err:?}"
+    );
+    assert!(err.to_string().contains("imu_quat_3.xml"), "{err}");
+    // A leg joint without its range: its drive could not enforce one.
+    let unlimited = robot.replacen(r#"range="-110 15""#, "", 1);
+    assert_ne!(unlimited, robot, "the model's knee range moved");
+    let path = dir.join("no_knee_range.xml");
+    std::fs::write(&path, unlimited).unwrap();
+    let err = Physics::load(&path).unwrap_err();
+    assert!(matches!(err, ModelError::JointRange { .. }), "{err:?}");
+    assert!(err.to_string().contains("knee"), "{err}");
+}

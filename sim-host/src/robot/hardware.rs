@@ -7,7 +7,7 @@
 
 use protocol::busload::SCHEDULE;
 use protocol::{
-    decode_frame, AnyMessage, ControllerMode, Drive, EncodeError, Frame, Leg, MessageId,
+    decode_frame, AnyMessage, ControllerMode, Drive, EncodeError, Frame, Joints, Leg, MessageId,
 };
 
 use crate::robot::imu::{ImuNode, ImuNoise};
@@ -26,10 +26,11 @@ pub struct Hardware {
 }
 
 impl Hardware {
-    /// The nodes, sending on the schedule of a controller running at `control_hz`.
-    pub fn new(control_hz: u32, imu_noise: ImuNoise) -> Self {
+    /// The nodes, sending on the schedule of a controller running at `control_hz`; each leg
+    /// drive enforces its joints' `leg_range_rad`.
+    pub fn new(control_hz: u32, imu_noise: ImuNoise, leg_range_rad: &Joints<[f64; 2]>) -> Self {
         Self {
-            legs: Leg::ALL.map(LegDrive::new),
+            legs: Leg::ALL.map(|leg| LegDrive::new(leg, *leg_range_rad.leg(leg))),
             wheel: WheelDrive::default(),
             imu: ImuNode::new(imu_noise),
             control_hz,
@@ -59,6 +60,12 @@ impl Hardware {
             .map(|leg| u64::from(leg.core().rejected()))
             .sum::<u64>()
             + u64::from(self.wheel.core().rejected())
+    }
+
+    /// Commands the drives clamped to their ratings, all drives together (see
+    /// [`LegDrive::clamped`], [`WheelDrive::clamped`]).
+    pub fn clamped(&self) -> u64 {
+        self.legs.iter().map(LegDrive::clamped).sum::<u64>() + self.wheel.clamped()
     }
 
     /// Hands a frame from the bus to every node (each filters and checks it itself).

@@ -1,6 +1,10 @@
 //! One leg's drive: four position servos (the report's position actuators, kp 180/200/260/160
 //! in the model) that take their targets from the controller's `LegTargets` frame and report
 //! joint position, velocity and torque in a `LegFeedback` frame.
+//!
+//! Like a real servo drive it enforces its own limits whatever the wire says: a target outside
+//! a joint's range (the model's `range`, the leg's mechanical stops) is clamped to it and the
+//! command counted ([`LegDrive::clamped`]).
 
 use protocol::{
     Angle, AnyMessage, DriveEnable, E2eCounter, Frame, JointVelocity, Joints, Leg, LegFeedback,
@@ -15,19 +19,37 @@ use crate::robot::physics::Physics;
 pub struct LegDrive {
     leg: Leg,
     core: DriveCore,
+    range_rad: [[f64; 2]; 4],
     targets_rad: [f64; 4],
+    clamped: u64,
     feedback_counter: E2eCounter,
 }
 
 impl LegDrive {
-    /// The drive of `leg`.
-    pub fn new(leg: Leg) -> Self {
+    /// The drive of `leg`, whose joints (hip abduction, hip pitch, knee, ankle) move within
+    /// `range_rad` ([low, high] each). The drive keeps its limits as the wire does, in counts of
+    /// the `Angle` field (1e-4 rad), so that a target the controller put exactly on a limit is
+    /// not clamped by the field's rounding.
+    pub fn new(leg: Leg, range_rad: [[f64; 2]; 4]) -> Self {
+        let in_counts = |rad: f64| f64::from(Angle::saturating_from_si(rad as f32).si());
         Self {
             leg,
             core: DriveCore::new(MessageId::LegTargets),
+            range_rad: range_rad.map(|[low, high]| [in_counts(low), in_counts(high)]),
             targets_rad: [0.0; 4],
+            clamped: 0,
             feedback_counter: E2eCounter::default(),
         }
+    }
+
+    /// The joint targets the servos hold (after clamping), rad.
+    pub fn targets_rad(&self) -> [f64; 4] {
+        self.targets_rad
+    }
+
+    /// Commands with a target outside a joint's range, clamped to it.
+    pub fn clamped(&self) -> u64 {
+        self.clamped
     }
 
     /// Which leg.
@@ -48,7 +70,15 @@ impl LegDrive {
     /// Takes a frame from the bus (see [`DriveCore::on_frame`]).
     pub fn on_frame(&mut self, now_us: u64, frame: &Frame) {
         if let Some(AnyMessage::LegTargets(targets)) = self.core.on_frame(now_us, frame) {
-            self.targets_rad = targets.position.leg(self.leg).map(|a| f64::from(a.si()));
+            let wanted = targets.position.leg(self.leg).map(|a| f64::from(a.si()));
+            let mut clamped = false;
+            for ((target, wanted), [low, high]) in
+                self.targets_rad.iter_mut().zip(wanted).zip(self.range_rad)
+            {
+                *target = wanted.clamp(low, high);
+                clamped |= *target != wanted;
+            }
+            self.clamped += u64::from(clamped);
             self.core
                 .set_commanded_enable(targets.enable == DriveEnable::Enabled);
         }

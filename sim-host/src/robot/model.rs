@@ -45,6 +45,27 @@ pub enum ModelError {
         /// What is wrong.
         detail: String,
     },
+    /// A sensor the hardware reads has the wrong number of values (the IMU's quaternion 4, its
+    /// gyro and accelerometer 3, a force or touch sensor 1).
+    #[error("the model {path}: sensor `{name}` has {found} values; the simulator reads {expected} (check its type in <sensor>)")]
+    SensorSize {
+        /// The file.
+        path: PathBuf,
+        /// The sensor.
+        name: String,
+        /// Values the hardware reads.
+        expected: usize,
+        /// Values the model gives.
+        found: usize,
+    },
+    /// A leg joint without a range: its drive needs the joint's limits to enforce them.
+    #[error("the model {path}: joint `{name}` needs limited=\"true\" and a range low < high (its drive enforces it)")]
+    JointRange {
+        /// The file.
+        path: PathBuf,
+        /// The joint.
+        name: String,
+    },
     /// The model's timestep does not divide the control period.
     #[error("the model {path} has timestep {timestep_s} s, which does not divide the control period {period_s} s")]
     Timestep {
@@ -76,6 +97,8 @@ pub struct Layout {
     pub wheel_actuator: [usize; 2],
     /// `sensordata` address of each leg actuator's force sensor.
     pub leg_force_sensor: Joints<usize>,
+    /// Each leg joint's range (the model's `range`), [low, high] rad: what its drive enforces.
+    pub leg_range_rad: Joints<[f64; 2]>,
     /// `sensordata` address of each wheel actuator's force sensor.
     pub wheel_force_sensor: [usize; 2],
     /// `sensordata` addresses of the IMU: quaternion (4), gyro (3), accelerometer (3).
@@ -106,24 +129,7 @@ pub fn load(path: &Path) -> Result<(MjModel, Layout), ModelError> {
 
 impl Layout {
     fn find(model: &MjModel, path: &Path) -> Result<Self, ModelError> {
-        let id = |kind: &'static str, obj: MjtObj, name: &str| {
-            model
-                .name_to_id(obj, name)
-                .ok_or_else(|| ModelError::Missing {
-                    path: path.to_owned(),
-                    kind,
-                    name: name.to_owned(),
-                })
-        };
-        let joint = |name: &str| id("joint", MjtObj::mjOBJ_JOINT, name);
-        let actuator = |name: &str| id("actuator", MjtObj::mjOBJ_ACTUATOR, name);
-        let sensor = |name: &str| {
-            id("sensor", MjtObj::mjOBJ_SENSOR, name).map(|s| model.sensor_adr()[s] as usize)
-        };
-        let geom = |name: &str| id("geom", MjtObj::mjOBJ_GEOM, name);
-        let qpos = |j: usize| model.jnt_qposadr()[j] as usize;
-        let qvel = |j: usize| model.jnt_dofadr()[j] as usize;
-
+        let find = Lookup { model, path };
         let mut layout = Layout {
             leg_qpos: Joints::splat(0),
             leg_qvel: Joints::splat(0),
@@ -133,47 +139,55 @@ impl Layout {
             wheel_qvel: [0; 2],
             wheel_actuator: [0; 2],
             leg_force_sensor: Joints::splat(0),
+            leg_range_rad: Joints::splat([0.0; 2]),
             wheel_force_sensor: [0; 2],
-            imu_quat: sensor("imu_quat")?,
-            imu_gyro: sensor("imu_gyro")?,
-            imu_accel: sensor("imu_accel")?,
+            imu_quat: find.sensor("imu_quat", 4)?,
+            imu_gyro: find.sensor("imu_gyro", 3)?,
+            imu_accel: find.sensor("imu_accel", 3)?,
             foot_touch: [0; 4],
-            torso_body: id("body", MjtObj::mjOBJ_BODY, "torso")?,
-            wheel_geoms: [geom("wheel_left")?, geom("wheel_right")?],
+            torso_body: find.id("body", MjtObj::mjOBJ_BODY, "torso")?,
+            wheel_geoms: [find.geom("wheel_left")?, find.geom("wheel_right")?],
             foot_geoms: [0; 4],
         };
         for (leg, names) in Joints::new(JOINT_NAMES).iter_legs() {
             for (k, name) in names.iter().enumerate() {
-                let j = joint(name)?;
-                layout.leg_qpos.leg_mut(leg)[k] = qpos(j);
-                layout.leg_qvel.leg_mut(leg)[k] = qvel(j);
-                layout.leg_actuator.leg_mut(leg)[k] = actuator(&format!("m_{name}"))?;
-                layout.leg_force_sensor.leg_mut(leg)[k] = sensor(&format!("frc_{name}"))?;
+                let j = find.joint(name)?;
+                layout.leg_qpos.leg_mut(leg)[k] = find.qpos(j);
+                layout.leg_qvel.leg_mut(leg)[k] = find.qvel(j);
+                layout.leg_actuator.leg_mut(leg)[k] = find.actuator(&format!("m_{name}"))?;
+                layout.leg_force_sensor.leg_mut(leg)[k] = find.sensor(&format!("frc_{name}"), 1)?;
+                layout.leg_range_rad.leg_mut(leg)[k] = find.range(j, name)?;
             }
         }
         for leg in Leg::ALL {
             let (i, suffix) = (leg as usize, leg.suffix());
             layout.leg_group[i] = model.actuator_group()[layout.leg_actuator.leg(leg)[0]] as u32;
-            layout.foot_touch[i] = sensor(&format!("touch_{suffix}"))?;
-            layout.foot_geoms[i] = geom(&format!("foot_{suffix}"))?;
+            layout.foot_touch[i] = find.sensor(&format!("touch_{suffix}"), 1)?;
+            layout.foot_geoms[i] = find.geom(&format!("foot_{suffix}"))?;
         }
         layout.check_leg_groups(model, path)?;
-        let groups = model.actuator_group();
+        layout.find_wheels(&find)?;
+        Ok(layout)
+    }
+
+    /// The wheels' joints, actuators and force sensors; their actuators in a group of no leg.
+    fn find_wheels(&mut self, find: &Lookup<'_>) -> Result<(), ModelError> {
+        let groups = find.model.actuator_group();
         for (i, side) in WHEEL_NAMES.iter().enumerate() {
-            let j = joint(&format!("wheel_{side}_joint"))?;
-            layout.wheel_qpos[i] = qpos(j);
-            layout.wheel_qvel[i] = qvel(j);
-            layout.wheel_actuator[i] = actuator(&format!("m_wheel_{side}"))?;
-            layout.wheel_force_sensor[i] = sensor(&format!("frc_wheel_{side}"))?;
-            let group = groups[layout.wheel_actuator[i]] as u32;
-            if layout.leg_group.contains(&group) {
+            let j = find.joint(&format!("wheel_{side}_joint"))?;
+            self.wheel_qpos[i] = find.qpos(j);
+            self.wheel_qvel[i] = find.qvel(j);
+            self.wheel_actuator[i] = find.actuator(&format!("m_wheel_{side}"))?;
+            self.wheel_force_sensor[i] = find.sensor(&format!("frc_wheel_{side}"), 1)?;
+            let group = groups[self.wheel_actuator[i]] as u32;
+            if self.leg_group.contains(&group) {
                 return Err(ModelError::ActuatorGroups {
-                    path: path.to_owned(),
+                    path: find.path.to_owned(),
                     detail: format!("m_wheel_{side} shares group {group} with a leg"),
                 });
             }
         }
-        Ok(layout)
+        Ok(())
     }
 
     /// Each leg's actuators in one group of its own (0…30), so that a leg can go torque-free
@@ -201,6 +215,72 @@ impl Layout {
             });
         }
         Ok(())
+    }
+}
+
+/// Finding the model's objects by name, each miss an error naming the file and the object.
+struct Lookup<'a> {
+    model: &'a MjModel,
+    path: &'a Path,
+}
+
+impl Lookup<'_> {
+    fn id(&self, kind: &'static str, obj: MjtObj, name: &str) -> Result<usize, ModelError> {
+        self.model
+            .name_to_id(obj, name)
+            .ok_or_else(|| ModelError::Missing {
+                path: self.path.to_owned(),
+                kind,
+                name: name.to_owned(),
+            })
+    }
+
+    fn joint(&self, name: &str) -> Result<usize, ModelError> {
+        self.id("joint", MjtObj::mjOBJ_JOINT, name)
+    }
+
+    fn actuator(&self, name: &str) -> Result<usize, ModelError> {
+        self.id("actuator", MjtObj::mjOBJ_ACTUATOR, name)
+    }
+
+    fn geom(&self, name: &str) -> Result<usize, ModelError> {
+        self.id("geom", MjtObj::mjOBJ_GEOM, name)
+    }
+
+    /// The `sensordata` address of sensor `name`, which must give `expected` values.
+    fn sensor(&self, name: &str, expected: usize) -> Result<usize, ModelError> {
+        let s = self.id("sensor", MjtObj::mjOBJ_SENSOR, name)?;
+        let found = self.model.sensor_dim()[s] as usize;
+        if found != expected {
+            return Err(ModelError::SensorSize {
+                path: self.path.to_owned(),
+                name: name.to_owned(),
+                expected,
+                found,
+            });
+        }
+        Ok(self.model.sensor_adr()[s] as usize)
+    }
+
+    fn qpos(&self, joint: usize) -> usize {
+        self.model.jnt_qposadr()[joint] as usize
+    }
+
+    fn qvel(&self, joint: usize) -> usize {
+        self.model.jnt_dofadr()[joint] as usize
+    }
+
+    /// Joint `name`'s range, [low, high] rad; an error unless it is limited with low < high.
+    fn range(&self, joint: usize, name: &str) -> Result<[f64; 2], ModelError> {
+        let [low, high] = self.model.jnt_range()[joint];
+        if self.model.jnt_limited()[joint] && low < high {
+            Ok([low, high])
+        } else {
+            Err(ModelError::JointRange {
+                path: self.path.to_owned(),
+                name: name.to_owned(),
+            })
+        }
     }
 }
 

@@ -1,5 +1,8 @@
 //! The wheel drive: two torque-controlled motors (the report's motor actuators, gear 1) that
 //! take `WheelCommand` frames and report angle, speed and torque in `WheelFeedback`.
+//!
+//! Like a real drive it enforces its rating whatever the wire says: a torque above
+//! [`WHEEL_PEAK_TORQUE_NM`] is clamped to it and the command counted ([`WheelDrive::clamped`]).
 
 use protocol::{
     AnyMessage, E2eCounter, Frame, MessageId, Torque, WheelAngle, WheelFeedback, WheelVelocity,
@@ -8,11 +11,17 @@ use protocol::{
 use crate::robot::drive_core::{Authority, DriveCore};
 use crate::robot::physics::Physics;
 
+/// The wheel motors' peak torque, N·m: a hub motor of the class that carries this 40 kg robot
+/// (the controller plans with the same figure, `Config::wheel_torque_limit_nm`; the drive does
+/// not trust it to).
+pub const WHEEL_PEAK_TORQUE_NM: f64 = 30.0;
+
 /// The emulated wheel drive.
 #[derive(Debug, Clone)]
 pub struct WheelDrive {
     core: DriveCore,
     torque_nm: [f64; 2],
+    clamped: u64,
     feedback_counter: E2eCounter,
 }
 
@@ -21,6 +30,7 @@ impl Default for WheelDrive {
         Self {
             core: DriveCore::new(MessageId::WheelCommand),
             torque_nm: [0.0; 2],
+            clamped: 0,
             feedback_counter: E2eCounter::default(),
         }
     }
@@ -40,9 +50,16 @@ impl WheelDrive {
     /// Takes a frame from the bus (see [`DriveCore::on_frame`]).
     pub fn on_frame(&mut self, now_us: u64, frame: &Frame) {
         if let Some(AnyMessage::WheelCommand(command)) = self.core.on_frame(now_us, frame) {
-            self.torque_nm = command.torque.map(|t| f64::from(t.si()));
+            let wanted = command.torque.map(|t| f64::from(t.si()));
+            self.torque_nm = wanted.map(|t| t.clamp(-WHEEL_PEAK_TORQUE_NM, WHEEL_PEAK_TORQUE_NM));
+            self.clamped += u64::from(self.torque_nm != wanted);
             self.core.set_commanded_enable(true);
         }
+    }
+
+    /// Commands with a torque above the rating, clamped to it.
+    pub fn clamped(&self) -> u64 {
+        self.clamped
     }
 
     /// The torques the motors apply for the next step: the command, or zero when the drive is

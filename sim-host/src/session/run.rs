@@ -41,6 +41,8 @@ pub struct SessionReport {
     pub firmware_rejected: Option<u64>,
     /// Frames the emulated drives rejected.
     pub drives_rejected: u64,
+    /// Commands the emulated drives clamped to their ratings.
+    pub drives_clamped: u64,
     /// Rendered frames, in order (empty without [`SessionConfig::frames`]).
     pub frames: Vec<PathBuf>,
     /// Whether [`SessionConfig::stop`] ended the run early.
@@ -103,6 +105,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
     }
     let frames = observer.watch.finish()?;
     let drives_rejected = sim.hardware().rejected();
+    let drives_clamped = sim.hardware().clamped();
     let rows = recorder.finish()?;
     write_outputs(config, &rows, &mut files)?;
     Ok(SessionReport {
@@ -111,6 +114,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         files,
         firmware_rejected,
         drives_rejected,
+        drives_clamped,
         frames,
         interrupted: observer.interrupted,
         segments,

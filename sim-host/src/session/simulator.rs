@@ -76,9 +76,10 @@ impl Simulator {
             });
         }
         physics.place(start.height_m, &start.leg_joint_rad);
+        let hardware = Hardware::new(control_hz, imu_noise, &physics.layout().leg_range_rad);
         Ok(Self {
             physics,
-            hardware: Hardware::new(control_hz, imu_noise),
+            hardware,
             steps_per_cycle: steps as u32,
             cycle_us: (period_s * 1e6).round() as u64,
             cycle: 0,

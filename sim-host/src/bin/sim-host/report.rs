@@ -40,6 +40,10 @@ pub(crate) fn print(
             .map(|n| format!(", {n} by the firmware"))
             .unwrap_or_default()
     );
+    println!(
+        "clamped          {} commands to the drives' ratings (joint range, wheel torque)",
+        report.drives_clamped
+    );
     if !args.faults.tx.is_clean() || !args.faults.rx.is_clean() {
         let [tx, rx] = report.fault_stats;
         println!("faults           {}", args.faults);
