@@ -16,8 +16,7 @@ pub enum BusError {
     /// The named CAN interface does not exist.
     #[error(
         "CAN interface `{ifname}` does not exist. For a virtual bus run:\n  \
-         sudo modprobe vcan && sudo ip link add {ifname} type vcan && sudo ip link set up {ifname}\n\
-         (or use `--bus inproc` for the in-process bus)"
+         sudo modprobe vcan && sudo ip link add {ifname} type vcan && sudo ip link set up {ifname}"
     )]
     NoSuchInterface {
         /// The interface asked for.
@@ -40,7 +39,7 @@ pub enum BusError {
     /// The kernel has no SocketCAN support at all.
     #[error(
         "this kernel has no SocketCAN support (opening `{ifname}`: {source}); load it with \
-         `sudo modprobe can can-raw vcan`, or use `--bus inproc`"
+         `sudo modprobe can can-raw vcan`"
     )]
     NoCanSupport {
         /// The interface.
@@ -56,6 +55,17 @@ pub enum BusError {
         /// The OS error.
         source: std::io::Error,
     },
+}
+
+impl BusError {
+    /// Whether the interface could not be opened at all (missing, or no CAN in the kernel):
+    /// a program that also runs on the in-process bus may say so (`--bus inproc`).
+    pub fn is_missing_interface(&self) -> bool {
+        matches!(
+            self,
+            BusError::NoSuchInterface { .. } | BusError::NoCanSupport { .. }
+        )
+    }
 }
 
 /// A node's connection to a CAN bus.

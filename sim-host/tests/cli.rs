@@ -64,9 +64,11 @@ fn a_missing_can_interface_names_the_commands_that_create_it() {
     let stderr = String::from_utf8_lossy(&result.stderr);
     assert_eq!(result.status.code(), Some(1), "{stderr}");
     assert!(
-        stderr.contains("sudo modprobe vcan && sudo ip link add vcan-absent9 type vcan"),
+        stderr.contains("sudo modprobe vcan && sudo ip link add vcan-absent9 type vcan")
+            || stderr.contains("sudo modprobe can can-raw vcan"),
         "{stderr}"
     );
+    assert!(stderr.contains("--bus inproc"), "{stderr}");
 }
 
 #[test]
@@ -140,5 +142,23 @@ fn the_old_imu_flag_names_still_work_for_one_release() {
             .unwrap();
         let stderr = String::from_utf8_lossy(&result.stderr);
         assert!(result.status.success(), "{flags:?}: {stderr}");
+    }
+}
+
+#[test]
+fn out_of_range_pace_and_duration_are_usage_errors_not_panics_or_hangs() {
+    for (flag, value, expected) in [
+        ("--pace", "1e-30", "factor of real time"),
+        ("--pace", "0", "factor of real time"),
+        ("--duration-s", "1e300", "simulated seconds"),
+        ("--duration-s", "-1", "simulated seconds"),
+    ] {
+        let result = sim_host()
+            .args(["run", &format!("{flag}={value}")])
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&result.stderr);
+        assert_eq!(result.status.code(), Some(2), "{flag} {value}: {stderr}");
+        assert!(stderr.contains(expected), "{flag} {value}: {stderr}");
     }
 }

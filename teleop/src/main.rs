@@ -140,7 +140,14 @@ fn run(cli: Cli) -> Result<(), Failure> {
             "--model and --out belong to --bus inproc (on a CAN bus the robot is elsewhere)".into(),
         ));
     }
-    let mut bus = SocketCanBus::open(&cli.bus).map_err(Failure::bus)?;
+    let mut bus = SocketCanBus::open(&cli.bus).map_err(|e| {
+        let hint = if e.is_missing_interface() {
+            "\n(or drive the simulated robot without CAN: `--bus inproc`)"
+        } else {
+            ""
+        };
+        Failure::bus(format!("{e}{hint}"))
+    })?;
     operate(&mut bus, &cli, scenario.as_ref(), &stop, &mut || None)
 }
 

@@ -39,9 +39,9 @@ struct Cli {
     /// Stop after this many control ticks.
     #[arg(long)]
     ticks: Option<u64>,
-    /// Lockstep: exit with an error when no SYNC arrives for this many seconds.
-    #[arg(long)]
-    idle_timeout_s: Option<f64>,
+    /// Lockstep: exit with an error when no SYNC arrives for this many seconds (0 < s ≤ 86400).
+    #[arg(long, value_parser = parse_idle_timeout)]
+    idle_timeout_s: Option<Duration>,
     /// Break the firmware's own bus connection on purpose: `rx.*` faults hit the feedback it
     /// receives, `tx.*` the commands it sends, e.g. `rx.drop=0.05,tx.flip=0.01,seed=3`
     /// (faults: drop, delay, duplicate, reorder, flip, replay, silence=NODE; delays count
@@ -57,6 +57,16 @@ enum ClockArg {
     /// The wall clock at --control-hz, as on the microcontroller.
     #[value(alias = "timer")]
     Wall,
+}
+
+/// `--idle-timeout-s`: a number of seconds, 0 < s ≤ 86400 (a day).
+fn parse_idle_timeout(text: &str) -> Result<Duration, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|s| *s > 0.0 && *s <= 86_400.0)
+        .map(Duration::from_secs_f64)
+        .ok_or_else(|| format!("`{text}`: give a number of seconds, 0 < s ≤ 86400"))
 }
 
 fn main() -> ExitCode {
@@ -81,10 +91,7 @@ fn main() -> ExitCode {
         },
         control_hz: cli.control_hz,
         max_ticks: cli.ticks,
-        idle_timeout: cli
-            .idle_timeout_s
-            .filter(|s| s.is_finite() && *s > 0.0)
-            .map(Duration::from_secs_f64),
+        idle_timeout: cli.idle_timeout_s,
     };
     tracing::info!(
         bus = %cli.bus,

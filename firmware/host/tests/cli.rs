@@ -33,3 +33,23 @@ fn new_and_old_clock_and_rate_flags_are_accepted_and_a_missing_bus_is_named() {
         "{stderr}"
     );
 }
+
+#[test]
+fn an_out_of_range_number_is_a_usage_error_not_a_panic() {
+    for value in ["1e20", "0", "-3", "nan", "soon"] {
+        let (code, stderr) = firmware_host(&[&format!("--idle-timeout-s={value}")]);
+        assert_eq!(code, Some(2), "--idle-timeout-s {value}: {stderr}");
+        assert!(stderr.contains("0 < s ≤ 86400"), "{stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+}
+
+#[test]
+fn a_missing_interface_does_not_suggest_a_bus_this_program_cannot_use() {
+    let (code, stderr) = firmware_host(&["--bus", "nosuchcan8"]);
+    assert_eq!(code, Some(1), "{stderr}");
+    assert!(
+        !stderr.contains("inproc"),
+        "firmware-host has no in-process bus: {stderr}"
+    );
+}

@@ -53,7 +53,7 @@ pub(crate) struct RunArgs {
     pub(crate) clock: ClockArg,
     /// Simulated seconds to run (default 10, or the scenario's `duration_s`; `--duration` is the
     /// old name).
-    #[arg(long = "duration-s", alias = "duration")]
+    #[arg(long = "duration-s", alias = "duration", value_parser = parse_duration_s)]
     pub(crate) duration_s: Option<f64>,
     /// A scenario file (`scenarios/*.toml`: times and commands); writes `summary.json` with
     /// figures per segment and prints them as a table. Replaces `--drive`.
@@ -76,9 +76,9 @@ pub(crate) struct RunArgs {
     /// Control rate, Hz (the model's timestep must divide the period).
     #[arg(long, default_value_t = 250)]
     pub(crate) control_hz: u32,
-    /// Lockstep: run at most this many times real time (1 = real time), still deterministic —
-    /// for watching, and for outside tools such as cansend and canplayer.
-    #[arg(long)]
+    /// Lockstep: run at most this many times real time (1 = real time, 0.001…1000000), still
+    /// deterministic — for watching, and for outside tools such as cansend and canplayer.
+    #[arg(long, value_parser = parse_pace)]
     pub(crate) pace: Option<f64>,
     /// Lockstep: how long to wait for the controller's command each cycle, ms.
     #[arg(long, default_value_t = 100)]
@@ -141,6 +141,35 @@ fn parse_step(text: &str) -> Result<PlanStep, String> {
     })
 }
 
+/// A number within `range`, or a message naming the text and the range.
+fn number_within(
+    text: &str,
+    range: std::ops::RangeInclusive<f64>,
+    what: &str,
+) -> Result<f64, String> {
+    text.trim()
+        .parse::<f64>()
+        .ok()
+        .filter(|x| range.contains(x))
+        .ok_or_else(|| {
+            format!(
+                "`{text}`: give {what} from {} to {}",
+                range.start(),
+                range.end()
+            )
+        })
+}
+
+/// `--pace`: times real time.
+fn parse_pace(text: &str) -> Result<f64, String> {
+    number_within(text, 0.001..=1e6, "a factor of real time")
+}
+
+/// `--duration-s`: simulated seconds, up to 1e6 (11.6 days; a soak run is 86,400).
+fn parse_duration_s(text: &str) -> Result<f64, String> {
+    number_within(text, f64::MIN_POSITIVE..=1e6, "simulated seconds")
+}
+
 /// Runs the session `args` describe and prints what it did.
 pub(crate) fn run(args: RunArgs) -> Result<(), String> {
     if args.viewer && !cfg!(feature = "viewer") {
@@ -170,7 +199,12 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
     }
     let config = session_config(&args, scenario.as_ref(), duration_s);
     tracing::info!(model = %config.model.display(), bus = %args.bus, "starting");
-    let report = session::run(&config).map_err(|e| e.to_string())?;
+    let report = session::run(&config).map_err(|e| match e {
+        session::SessionError::Bus(bus) if bus.is_missing_interface() => {
+            format!("{bus}\n(or run the firmware in this process: `--bus inproc`)")
+        }
+        other => other.to_string(),
+    })?;
     crate::report::print(&args, scenario.as_ref(), &report)
 }
 
