@@ -1,8 +1,15 @@
-//! Integer time: durations in ticks, watchdogs across the counter wrap.
+//! Integer time: durations in ticks, watchdogs across the counter wrap, and a whole node
+//! trotting across it.
 
+mod common;
+
+use std::collections::HashMap;
+
+use firmware::control::fsm::{Direction, LegMotion, State};
 use firmware::control::safety::Watchdog;
 use firmware::legs::smoothing::Smoother;
-use firmware::{Tick, TickRate};
+use firmware::{Config, Node, Tick, TickRate};
+use protocol::{AnyMessage, FaultFlags, TeleopHeartbeat, TeleopMode};
 
 #[test]
 fn milliseconds_round_up_to_whole_ticks() {
@@ -42,4 +49,47 @@ fn the_reports_smoothing_in_ticks() {
     // Rates that would overshoot in one tick are capped, and NaN holds.
     assert_eq!(Smoother::new(1e6, TickRate::SIM_250_HZ).alpha(), 1.0);
     assert_eq!(Smoother::new(f32::NAN, TickRate::SIM_250_HZ).alpha(), 0.0);
+}
+
+#[test]
+fn a_node_trots_on_across_the_tick_counter_wrap() {
+    // Started 4 s before its tick counter wraps (about 199 days of uptime at 250 Hz), on an
+    // ideal plant with the operator holding L: it must trot through the wrap without a
+    // watchdog, the link monitor or the schedule noticing anything.
+    let config = Config::ROBOT;
+    let mut node = Node::new(config).unwrap();
+    let mut joints = common::standing_joints_rad(&config);
+    let mut counters: HashMap<u16, u16> = HashMap::new();
+    let mut send = |node: &mut Node, now: Tick, message: AnyMessage| {
+        let counter = counters.entry(message.id().raw()).or_insert(0);
+        let frame = message.encode(*counter).unwrap();
+        *counter = counter.wrapping_add(1);
+        node.on_frame(now, frame.id(), frame.data()).unwrap();
+    };
+    let start = Tick(u32::MAX - 1000);
+    let trot = State::Legs(LegMotion::Trot(Direction::Forward));
+    for k in 0..2500_u32 {
+        let now = start.plus(k);
+        for message in common::plant_feedback(&joints) {
+            send(&mut node, now, message);
+        }
+        if k % 5 == 0 {
+            send(&mut node, now, common::command(TeleopMode::TrotForward));
+            let uptime = protocol::Millis::from_raw(k * 4).unwrap();
+            send(
+                &mut node,
+                now,
+                AnyMessage::TeleopHeartbeat(TeleopHeartbeat { uptime }),
+            );
+        }
+        let (output, frames) = node.poll(now);
+        assert_eq!(output.status.faults, FaultFlags::EMPTY, "tick {}", now.0);
+        assert!(!frames.is_empty(), "tick {}: nothing sent", now.0);
+        if output.legs_enabled {
+            joints = output.leg_targets_rad;
+        }
+        if k >= 500 {
+            assert_eq!(node.controller().state(), trot, "tick {}", now.0);
+        }
+    }
 }

@@ -47,6 +47,17 @@ pub enum BusError {
         /// The OS error.
         source: std::io::Error,
     },
+    /// The interface's transmit queue stayed full (`ENOBUFS`) for the whole send deadline.
+    #[error(
+        "CAN interface `{ifname}` took no frame for {waited:?}: its transmit queue stays full. Is \
+         the bus off or unplugged? (`ip -details -statistics link show {ifname}`)"
+    )]
+    TxQueueFull {
+        /// The interface.
+        ifname: String,
+        /// How long the send waited.
+        waited: std::time::Duration,
+    },
     /// Any other I/O error.
     #[error("CAN interface `{ifname}`: {source}")]
     Io {

@@ -4,7 +4,7 @@
 
 use std::io::ErrorKind;
 use std::path::Path;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use socketcan::{CanAnyFrame, CanFdFrame, CanFdSocket, EmbeddedFrame, Id, Socket, StandardId};
 
@@ -100,6 +100,29 @@ fn classify(ifname: &str, source: std::io::Error) -> BusError {
     }
 }
 
+/// Longest a frame waits for room in the interface's transmit queue (`ENOBUFS`) before `send`
+/// gives up: a queue that stays full this long belongs to a bus that is off, unplugged or
+/// starved, and a caller blocked here could not even hear Ctrl-C.
+pub const SEND_DEADLINE: Duration = Duration::from_millis(100);
+
+/// Calls `write` until it succeeds, fails with anything but `ENOBUFS`, or `deadline` has
+/// passed since the first call (then the last `ENOBUFS` error is returned), sleeping 100 µs
+/// between tries.
+pub fn write_within(
+    deadline: Duration,
+    mut write: impl FnMut() -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let start = Instant::now();
+    loop {
+        match write() {
+            Err(e) if e.raw_os_error() == Some(ENOBUFS) && start.elapsed() < deadline => {
+                std::thread::sleep(Duration::from_micros(100));
+            }
+            other => return other,
+        }
+    }
+}
+
 impl Bus for SocketCanBus {
     fn send(&mut self, frame: &Frame) -> Result<(), BusError> {
         let id = StandardId::new(frame.id()).ok_or_else(|| BusError::Io {
@@ -110,26 +133,40 @@ impl Bus for SocketCanBus {
             ifname: self.ifname.clone(),
             source: std::io::Error::new(ErrorKind::InvalidInput, "not a CAN FD length"),
         })?;
-        loop {
-            match self.socket.write_frame(&fd) {
-                Ok(()) => return Ok(()),
-                // The interface's transmit queue is full: wait for it to drain.
-                Err(e) if e.raw_os_error() == Some(ENOBUFS) => {
-                    std::thread::sleep(Duration::from_micros(100));
+        let socket = &self.socket;
+        write_within(SEND_DEADLINE, || socket.write_frame(&fd)).map_err(|e| {
+            if e.raw_os_error() == Some(ENOBUFS) {
+                BusError::TxQueueFull {
+                    ifname: self.ifname.clone(),
+                    waited: SEND_DEADLINE,
                 }
-                Err(e) => return Err(classify(&self.ifname, e)),
+            } else {
+                classify(&self.ifname, e)
             }
-        }
+        })
     }
 
     fn recv(&mut self, timeout: Duration) -> Result<Option<Frame>, BusError> {
+        // One deadline for the whole call: skipping foreign frames or an interrupted read does
+        // not restart the wait, so a babbling foreign node cannot hold the caller here.
+        let deadline = Instant::now() + timeout;
         loop {
-            let any = match self.socket.read_frame_timeout(timeout) {
+            let left = deadline.saturating_duration_since(Instant::now());
+            // poll(2) counts whole milliseconds: a shorter wait would poll with 0 and spin a
+            // core until the deadline, so it sleeps instead and then looks once.
+            let poll_for = if left < Duration::from_millis(1) {
+                std::thread::sleep(left);
+                Duration::ZERO
+            } else {
+                left
+            };
+            let any = match self.socket.read_frame_timeout(poll_for) {
                 Ok(frame) => frame,
                 Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock) => {
                     return Ok(None)
                 }
-                Err(e) if e.kind() == ErrorKind::Interrupted => continue,
+                Err(e) if e.kind() == ErrorKind::Interrupted && !left.is_zero() => continue,
+                Err(e) if e.kind() == ErrorKind::Interrupted => return Ok(None),
                 Err(e) => return Err(classify(&self.ifname, e)),
             };
             let converted = match &any {
@@ -140,6 +177,9 @@ impl Bus for SocketCanBus {
             match converted {
                 Some(frame) => return Ok(Some(frame)),
                 None => self.foreign += 1,
+            }
+            if Instant::now() >= deadline {
+                return Ok(None);
             }
         }
     }
@@ -174,5 +214,32 @@ mod tests {
             text.contains("ip link add vcan-missing7 type vcan"),
             "{text}"
         );
+    }
+
+    #[test]
+    fn a_full_transmit_queue_gives_up_at_the_deadline() {
+        let full = || Err(std::io::Error::from_raw_os_error(ENOBUFS));
+        let started = Instant::now();
+        let error = write_within(Duration::from_millis(30), full).unwrap_err();
+        let waited = started.elapsed();
+        assert_eq!(error.raw_os_error(), Some(ENOBUFS));
+        assert!(waited >= Duration::from_millis(30), "{waited:?}");
+        assert!(waited < Duration::from_secs(1), "{waited:?}");
+        // A queue that drains after a few tries takes the frame.
+        let mut tries = 0;
+        let draining = || {
+            tries += 1;
+            if tries < 4 {
+                Err(std::io::Error::from_raw_os_error(ENOBUFS))
+            } else {
+                Ok(())
+            }
+        };
+        assert!(write_within(Duration::from_millis(30), draining).is_ok());
+        // Any other error is returned at once.
+        let started = Instant::now();
+        let down = || Err(std::io::Error::from_raw_os_error(100));
+        assert!(write_within(Duration::from_secs(10), down).is_err());
+        assert!(started.elapsed() < Duration::from_secs(1));
     }
 }

@@ -164,7 +164,7 @@ fn wall(
         tick = tick.plus(1);
         bus.end_cycle()?;
         slot += 1;
-        let deadline = start + period * u32::try_from(slot).unwrap_or(u32::MAX);
+        let deadline = start + slot_start(period, slot);
         // Wait for the next tick, taking frames as they come so that they are timely.
         while Instant::now() < deadline {
             let mut port = BusPort::new(&mut *bus, Wait::Until(deadline));
@@ -175,13 +175,24 @@ fn wall(
     Ok(())
 }
 
+/// When period `slot` begins, counted from the start: `period × slot`, exact for any `u64`
+/// slot (saturating only past `Duration::MAX`). A `u32` slot count would stop the clock after
+/// 2^32 periods (49.7 days at 1 kHz) and run every later tick back to back.
+pub fn slot_start(period: Duration, slot: u64) -> Duration {
+    let nanos = period.as_nanos().saturating_mul(u128::from(slot));
+    let secs = u64::try_from(nanos / 1_000_000_000).unwrap_or(u64::MAX);
+    // The remainder is below 10^9, so it fits.
+    let subsec = u32::try_from(nanos % 1_000_000_000).unwrap_or(0);
+    Duration::new(secs, subsec)
+}
+
 /// The period a tick due in `slot` runs in, when it starts `elapsed` after the start. As the
 /// MCU's SysTick loop does, a runner that woke in a later period runs the tick in that one and
 /// loses the ticks of the periods it slept through (counted in `lost`) rather than bunching
 /// them up: the core measures every timeout in ticks, and a burst of ticks with no frames
 /// between them would age the feedback read just before it by the length of the stall. So
 /// at most one tick runs per period.
-fn current_slot(slot: u64, elapsed: Duration, period: Duration, lost: &mut u64) -> u64 {
+pub fn current_slot(slot: u64, elapsed: Duration, period: Duration, lost: &mut u64) -> u64 {
     let now = u64::try_from(elapsed.as_nanos() / period.as_nanos().max(1)).unwrap_or(u64::MAX);
     if now > slot {
         *lost += now - slot;

@@ -184,3 +184,30 @@ fn a_stalled_wall_clock_runner_loses_the_missed_ticks_instead_of_bunching_them_u
         sent.windows(2).map(|w| w[1] - w[0]).collect::<Vec<_>>()
     );
 }
+
+#[test]
+fn the_wall_clock_schedule_keeps_going_past_two_to_the_32_periods() {
+    use firmware_host::runner::{current_slot, slot_start};
+    let period = Duration::from_millis(1);
+    let wrap = 1_u64 << 32;
+    // Each period begins one period after the last, on both sides of 2^32 (49.7 days at 1 kHz):
+    // a schedule that stops there would run every later tick back to back.
+    for slot in [wrap - 2, wrap - 1, wrap, wrap + 1, 3 * wrap] {
+        assert_eq!(
+            slot_start(period, slot + 1) - slot_start(period, slot),
+            period,
+            "slot {slot}"
+        );
+    }
+    assert_eq!(slot_start(period, wrap), Duration::from_millis(wrap));
+    // Waking in the period after 2^32 runs there and counts the one missed tick.
+    let mut lost = 0;
+    let elapsed = slot_start(period, wrap + 1) + Duration::from_micros(10);
+    assert_eq!(current_slot(wrap, elapsed, period, &mut lost), wrap + 1);
+    assert_eq!(lost, 1);
+    // A huge slot saturates instead of overflowing.
+    assert_eq!(
+        slot_start(Duration::from_secs(1), u64::MAX).as_secs(),
+        u64::MAX
+    );
+}
