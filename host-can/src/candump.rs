@@ -81,6 +81,11 @@ impl<W: Write> CandumpWriter<W> {
         self.out.write_all(self.line.as_bytes())
     }
 
+    /// Flushes the inner writer (puts the lines written so far where it writes them).
+    pub fn flush(&mut self) -> io::Result<()> {
+        self.out.flush()
+    }
+
     /// Flushes the inner writer and returns it.
     pub fn finish(mut self) -> io::Result<W> {
         self.out.flush()?;

@@ -50,7 +50,7 @@ pub fn run(
             options.reply_timeout,
             &mut peers,
         )?;
-        recorder.row(sim.telemetry());
+        recorder.row(sim.telemetry())?;
         if !observe(sim, &stats) {
             break;
         }

@@ -1,21 +1,33 @@
-//! Collects what a run leaves behind: telemetry rows in memory (written as CSV and plots at the
-//! end) and every frame on the bus, streamed to a candump log.
+//! Collects what a run leaves behind: every frame on the bus streamed to a candump log, every
+//! telemetry row streamed to a CSV file and kept in memory for the plots drawn at the end.
+//!
+//! The logs are on disk as the run goes: both files are flushed at least once a second (wall
+//! clock), so a run that is killed outright leaves them readable up to within a second of the
+//! kill; a run that fails or is stopped flushes them as it ends (dropping the writers flushes
+//! too).
 
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use protocol::Frame;
 
 use crate::output::output_error::OutputError;
 use crate::output::telemetry::TelemetryRow;
+use crate::output::telemetry_csv::CsvWriter;
 use host_can::candump::{CandumpWriter, LoggedFrame};
+
+/// Longest the logs stay in memory buffers before they are flushed to disk.
+pub const FLUSH_EVERY: Duration = Duration::from_secs(1);
 
 /// The recorder of one run.
 #[derive(Debug, Default)]
 pub struct Recorder {
     rows: Vec<TelemetryRow>,
     candump: Option<(PathBuf, CandumpWriter<BufWriter<File>>)>,
+    csv: Option<CsvWriter>,
+    last_flush: Option<Instant>,
     frames: u64,
     discard_rows: bool,
 }
@@ -34,6 +46,15 @@ impl Recorder {
         }
     }
 
+    /// A recorder that streams every frame to `log` in candump format, labelled with
+    /// `interface` (so that `canplayer` can replay it there), and every row to the CSV file
+    /// `csv`.
+    pub fn with_files(log: &Path, csv: &Path, interface: &str) -> Result<Self, OutputError> {
+        let mut recorder = Self::with_candump(log, interface)?;
+        recorder.csv = Some(CsvWriter::create(csv)?);
+        Ok(recorder)
+    }
+
     /// A recorder that also writes every frame to `path` in candump format, labelled with
     /// `interface` (so that `canplayer` can replay it there).
     pub fn with_candump(path: &Path, interface: &str) -> Result<Self, OutputError> {
@@ -49,6 +70,7 @@ impl Recorder {
         })?;
         Ok(Self {
             candump: Some((path.to_owned(), writer)),
+            last_flush: Some(Instant::now()),
             ..Self::default()
         })
     }
@@ -70,11 +92,37 @@ impl Recorder {
         Ok(())
     }
 
-    /// Keeps one telemetry row.
-    pub fn row(&mut self, row: TelemetryRow) {
+    /// Keeps one telemetry row (and writes it to the CSV file); once a second, flushes the
+    /// logs to disk.
+    pub fn row(&mut self, row: TelemetryRow) -> Result<(), OutputError> {
+        if let Some(csv) = &mut self.csv {
+            csv.write(&row)?;
+        }
         if !self.discard_rows {
             self.rows.push(row);
         }
+        if self
+            .last_flush
+            .is_some_and(|at| at.elapsed() >= FLUSH_EVERY)
+        {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    /// Puts everything logged so far on disk.
+    pub fn flush(&mut self) -> Result<(), OutputError> {
+        if let Some(csv) = &mut self.csv {
+            csv.flush()?;
+        }
+        if let Some((path, writer)) = &mut self.candump {
+            writer.flush().map_err(|source| OutputError::Io {
+                path: path.clone(),
+                source,
+            })?;
+        }
+        self.last_flush = Some(Instant::now());
+        Ok(())
     }
 
     /// The rows so far.
@@ -87,8 +135,11 @@ impl Recorder {
         self.frames
     }
 
-    /// Flushes the candump log and returns the rows.
+    /// Flushes the logs and returns the rows.
     pub fn finish(self) -> Result<Vec<TelemetryRow>, OutputError> {
+        if let Some(csv) = self.csv {
+            csv.finish()?;
+        }
         if let Some((path, writer)) = self.candump {
             writer
                 .finish()

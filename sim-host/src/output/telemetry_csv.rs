@@ -1,8 +1,8 @@
 //! Telemetry as a CSV file: one header line, then one line per [`TelemetryRow`].
 
 use std::fs::File;
-use std::io::{BufWriter, Write};
-use std::path::Path;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
 
 use protocol::JOINT_NAMES;
 
@@ -43,23 +43,57 @@ pub fn header() -> Vec<String> {
         .collect()
 }
 
-/// Writes `rows` to `path` (created or truncated) under [`header`]. Numbers are written in
-/// their shortest exact decimal form (`NaN` and `inf` as such); the mode is its
-/// [`protocol::ControllerMode::label`], or empty before the first controller status. No rows
-/// gives a file with only the header.
+/// Writes `rows` to `path` (created or truncated) under [`header`]; see [`CsvWriter`].
 pub fn write_csv(path: &Path, rows: &[TelemetryRow]) -> Result<(), OutputError> {
-    let file = File::create(path).map_err(|source| io_error(path, source))?;
-    let mut writer = csv::Writer::from_writer(BufWriter::new(file));
-    let csv_error = |source| OutputError::Csv {
-        path: path.to_path_buf(),
-        source,
-    };
-    let header = header();
-    writer.write_record(&header).map_err(csv_error)?;
-    let mut record = Vec::with_capacity(header.len());
+    let mut writer = CsvWriter::create(path)?;
     for row in rows {
-        record.clear();
-        record.push(row.time_s.to_string());
+        writer.write(row)?;
+    }
+    writer.finish()
+}
+
+/// Telemetry rows streamed to a CSV file as a run goes. Numbers are written in their shortest
+/// exact decimal form (`NaN` and `inf` as such); the mode is its
+/// [`protocol::ControllerMode::label`], or empty before the first controller status. Rows are
+/// buffered: [`CsvWriter::flush`] puts them on disk (the recorder does so every second), and
+/// dropping the writer flushes too.
+pub struct CsvWriter {
+    path: PathBuf,
+    writer: csv::Writer<BufWriter<File>>,
+    record: Vec<String>,
+}
+
+impl std::fmt::Debug for CsvWriter {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("CsvWriter")
+            .field("path", &self.path)
+            .finish()
+    }
+}
+
+impl CsvWriter {
+    /// Creates (or truncates) `path` and writes the [`header`].
+    pub fn create(path: &Path) -> Result<Self, OutputError> {
+        let file = File::create(path).map_err(|source| io_error(path, source))?;
+        let mut writer = csv::Writer::from_writer(BufWriter::new(file));
+        let header = header();
+        writer
+            .write_record(&header)
+            .map_err(|source| OutputError::Csv {
+                path: path.to_path_buf(),
+                source,
+            })?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            writer,
+            record: Vec::with_capacity(header.len()),
+        })
+    }
+
+    /// Appends one row.
+    pub fn write(&mut self, row: &TelemetryRow) -> Result<(), OutputError> {
+        self.record.clear();
+        self.record.push(row.time_s.to_string());
         let numbers = row
             .torso_pos_m
             .iter()
@@ -68,15 +102,34 @@ pub fn write_csv(path: &Path, rows: &[TelemetryRow]) -> Result<(), OutputError> 
             .chain(&row.wheel_torque_nm)
             .chain(&row.wheel_speed_rad_s)
             .chain(&row.foot_force_n);
-        record.extend(numbers.map(f64::to_string));
-        record.push(u8::from(row.body_contact).to_string());
-        record.push(row.mode.map_or("", |mode| mode.label()).to_owned());
-        writer.write_record(&record).map_err(csv_error)?;
+        self.record.extend(numbers.map(f64::to_string));
+        self.record.push(u8::from(row.body_contact).to_string());
+        self.record
+            .push(row.mode.map_or("", |mode| mode.label()).to_owned());
+        self.writer
+            .write_record(&self.record)
+            .map_err(|source| OutputError::Csv {
+                path: self.path.clone(),
+                source,
+            })
     }
-    let mut inner = writer
-        .into_inner()
-        .map_err(|error| io_error(path, error.into_error()))?;
-    inner.flush().map_err(|source| io_error(path, source))
+
+    /// Puts every row written so far on disk.
+    pub fn flush(&mut self) -> Result<(), OutputError> {
+        self.writer
+            .flush()
+            .map_err(|source| io_error(&self.path, source))
+    }
+
+    /// Flushes and closes the file.
+    pub fn finish(mut self) -> Result<(), OutputError> {
+        self.flush()
+    }
+
+    /// The file written.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
 }
 
 fn io_error(path: &Path, source: std::io::Error) -> OutputError {

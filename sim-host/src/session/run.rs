@@ -139,25 +139,23 @@ fn open_recorder(
                 path: dir.clone(),
                 source,
             })?;
-            let log = dir.join("bus.log");
+            let (log, csv) = (dir.join("bus.log"), dir.join("telemetry.csv"));
             files.push(log.clone());
-            Recorder::with_candump(&log, interface)?
+            files.push(csv.clone());
+            Recorder::with_files(&log, &csv, interface)?
         }
         None if config.attach.is_some() => Recorder::discarding(),
         None => Recorder::in_memory(),
     })
 }
 
-/// The telemetry CSV and the plots, after the run.
+/// The plots, after the run (the logs were written as it went).
 fn write_outputs(
     config: &SessionConfig,
     rows: &[TelemetryRow],
     files: &mut Vec<PathBuf>,
 ) -> Result<(), SessionError> {
     if let Some(dir) = &config.out_dir {
-        let csv = dir.join("telemetry.csv");
-        crate::output::telemetry_csv::write_csv(&csv, rows)?;
-        files.push(csv);
         if config.plots {
             files.extend(crate::output::plots::write_plots(dir, rows)?);
         }
