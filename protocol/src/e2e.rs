@@ -170,8 +170,9 @@ impl E2eChecker {
             .filter(|candidate| candidate.wrapping_sub(last) < HALF)
         {
             match counter.wrapping_sub(candidate) {
-                // Continues the pending counter: the sequence resynchronises, nothing skipped.
-                1 => return None,
+                // The pending counter again (a repeat), or the one after it (the sequence
+                // resynchronises there): nothing skipped.
+                0 | 1 => return None,
                 delta if (2..HALF).contains(&delta) => return Some(delta - 1),
                 _ => {}
             }

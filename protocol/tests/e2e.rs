@@ -142,11 +142,32 @@ fn a_jump_past_the_window_names_the_frames_skipped_and_a_step_back_none() {
     assert_eq!(checker.skipped_ahead(40), Some(9));
     assert_eq!(checker.check_counter(40), E2eStatus::WrongSequence);
     assert_eq!(
+        checker.skipped_ahead(40),
+        None,
+        "the pending counter again: a repeat"
+    );
+    assert_eq!(
+        checker.skipped_ahead(35),
+        Some(24),
+        "behind the pending counter but past the window: counted from the last accepted"
+    );
+    assert_eq!(
         checker.skipped_ahead(41),
         None,
         "the sequence resynchronises here"
     );
     assert_eq!(checker.check_counter(41), E2eStatus::Initial);
+}
+
+#[test]
+fn half_the_counter_range_ahead_counts_as_behind() {
+    let checker = checker_after(&[10]);
+    assert_eq!(checker.skipped_ahead(10 + 0x7FFF), Some(0x7FFE));
+    assert_eq!(checker.skipped_ahead(10 + 0x8000), None);
+    // A pending counter half the range ahead is no reference either.
+    let mut checker = checker_after(&[10]);
+    assert_eq!(checker.check_counter(10 + 0x8000), E2eStatus::WrongSequence);
+    assert_eq!(checker.skipped_ahead(10 + 0x8005), None);
 }
 
 #[test]
@@ -173,4 +194,22 @@ fn the_receiver_counts_frames_skipped_by_a_long_burst_as_lost() {
     let frame = sync(1);
     assert!(receiver.receive(frame.id(), frame.data()).is_err());
     assert_eq!(receiver.counters().lost.raw(), 30);
+}
+
+#[test]
+fn only_in_sequence_frames_are_accepted() {
+    for status in [
+        E2eStatus::Ok,
+        E2eStatus::OkSomeLost { lost: 3 },
+        E2eStatus::Initial,
+    ] {
+        assert!(status.is_accepted(), "{status:?}");
+    }
+    for status in [
+        E2eStatus::Repeated,
+        E2eStatus::WrongSequence,
+        E2eStatus::CrcError,
+    ] {
+        assert!(!status.is_accepted(), "{status:?}");
+    }
 }

@@ -13,6 +13,7 @@ mod firmware;
 mod fuzz;
 mod hil;
 mod mujoco;
+mod mutants;
 mod pil;
 mod same_run;
 mod setup;
@@ -55,6 +56,9 @@ Tasks:
                      silent feedback, a killed firmware, a restarted simulator, E-stops) on the
                      closed loop in-process; writes its table into docs/faults.md (--check: fail
                      if the table there is stale)
+  mutants [FILE…]    mutation testing (cargo-mutants, installed if missing) of the
+                     safety-critical modules: fails on a mutant no test kills (long: minutes per
+                     file; not part of `test`)
   same-run REV       proof that behaviour did not change: builds sim-host at git revision REV
                      and from the working tree, runs every shipped scenario with both, and
                      compares summary.json (all but the wall-clock fields), bus.log and
@@ -90,6 +94,7 @@ fn main() -> ExitCode {
         "fuzz" => fuzz::run(rest),
         "faults" => faults::run(rest),
         "same-run" => same_run::run(rest),
+        "mutants" => mutants::run(rest),
         "help" | "-h" | "--help" => {
             print!("{HELP}");
             Ok(())

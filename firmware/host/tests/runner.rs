@@ -90,6 +90,75 @@ fn a_quiet_bus_in_lockstep_is_an_error_naming_the_simulator() {
 }
 
 #[test]
+fn heartbeats_without_sync_still_end_in_the_idle_timeout_and_a_stop_is_heard() {
+    // A teleop keeps talking (heartbeats at 50 Hz), but no simulator sends SYNC: the idle
+    // timeout must still fire; it used to be reset by any frame.
+    let bus = InprocBus::new();
+    let mut firmware_bus = bus.endpoint();
+    let mut teleop = bus.endpoint();
+    let done = Arc::new(AtomicBool::new(false));
+    let talking = Arc::clone(&done);
+    let talker = std::thread::spawn(move || {
+        let mut counter = E2eCounter::default();
+        let mut uptime_ms = 0;
+        while !talking.load(Ordering::Relaxed) {
+            let beat = AnyMessage::TeleopHeartbeat(protocol::TeleopHeartbeat {
+                uptime: protocol::Millis::from_raw(uptime_ms).unwrap(),
+            });
+            teleop
+                .send(&beat.encode(counter.advance()).unwrap())
+                .unwrap();
+            uptime_ms += 20;
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    });
+    let started = Instant::now();
+    let result = runner::run(
+        &mut firmware_bus,
+        RunnerConfig {
+            clock: Clock::Lockstep,
+            control_hz: 250,
+            max_ticks: None,
+            idle_timeout: Some(Duration::from_millis(300)),
+        },
+        &AtomicBool::new(false),
+    );
+    let waited = started.elapsed();
+    done.store(true, Ordering::Relaxed);
+    talker.join().unwrap();
+    let err = result.unwrap_err();
+    assert!(err.to_string().contains("no SYNC"), "{err}");
+    assert!(waited < Duration::from_secs(2), "took {waited:?}");
+
+    // And a stop request is heard within the lockstep wait, traffic or not.
+    let stop = Arc::new(AtomicBool::new(false));
+    let later = Arc::clone(&stop);
+    let stopper = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(200));
+        later.store(true, Ordering::Relaxed);
+        Instant::now()
+    });
+    let stats = runner::run(
+        &mut bus.endpoint(),
+        RunnerConfig {
+            clock: Clock::Lockstep,
+            control_hz: 250,
+            max_ticks: None,
+            idle_timeout: None,
+        },
+        &stop,
+    )
+    .unwrap();
+    let asked = stopper.join().unwrap();
+    assert!(
+        asked.elapsed() < Duration::from_millis(500),
+        "stopped {:?} late",
+        asked.elapsed()
+    );
+    assert_eq!(stats.ticks, 0);
+}
+
+#[test]
 fn on_the_wall_clock_it_keeps_its_own_time() {
     let bus = InprocBus::new();
     let mut listener = bus.endpoint();

@@ -1,0 +1,92 @@
+//! `cargo xtask mutants [FILE…]`: mutation testing of the safety-critical modules with
+//! `cargo-mutants` (installed if missing). Each mutant of these files — a function that returns
+//! a constant, an operator swapped, a condition negated — must make some test of its own crate
+//! fail; a mutant that survives is a behaviour no test looks at. The task fails on any survivor
+//! not listed in [`EQUIVALENT`] with the reason it cannot be told apart.
+//!
+//! A long task (minutes per file on two cores), documented in docs/faults.md and not part of
+//! `cargo xtask test`. With FILE arguments it tests only those files.
+
+use std::process::Command;
+
+use crate::util::{cargo, root, run as sh};
+
+/// The safety-critical modules: the receive checks, the watchdogs and clamps, the link monitor,
+/// the operator-command budget, the mode machine and the service loop.
+const FILES: [&str; 7] = [
+    "protocol/src/e2e.rs",
+    "protocol/src/receiver.rs",
+    "firmware/src/control/safety.rs",
+    "firmware/src/node/link.rs",
+    "firmware/src/node/rate_limit.rs",
+    "firmware/src/control/fsm.rs",
+    "firmware/src/node/service.rs",
+];
+
+/// Mutants that survive because no behaviour tells them apart, with the reason. Each entry is
+/// the start of the line cargo-mutants prints in `missed.txt`.
+const EQUIVALENT: [(&str, &str); 0] = [];
+
+pub fn run(args: &[String]) -> Result<(), String> {
+    let files: Vec<&str> = if args.is_empty() {
+        FILES.to_vec()
+    } else {
+        args.iter().map(String::as_str).collect()
+    };
+    ensure_cargo_mutants()?;
+    let out = root().join("target").join("mutants");
+    let mut cmd = cargo();
+    cmd.args([
+        "mutants",
+        "--no-shuffle",
+        "--test-workspace=false",
+        "--output",
+    ])
+    .arg(&out);
+    for package in ["protocol", "firmware"] {
+        cmd.args(["--package", package]);
+    }
+    for file in &files {
+        cmd.args(["--file", file]);
+    }
+    // cargo-mutants exits 2 when mutants survive: the list below says which.
+    let _ = sh(&mut cmd);
+    let missed_path = out.join("mutants.out").join("missed.txt");
+    let missed = std::fs::read_to_string(&missed_path).map_err(|e| {
+        format!(
+            "{}: {e} (did cargo-mutants run? see its output above)",
+            missed_path.display()
+        )
+    })?;
+    let survivors: Vec<&str> = missed
+        .lines()
+        .filter(|line| !line.trim().is_empty())
+        .filter(|line| !EQUIVALENT.iter().any(|(start, _)| line.starts_with(start)))
+        .collect();
+    println!(
+        "MEASURED mutants: {} files, {} surviving mutants outside the documented equivalents",
+        files.len(),
+        survivors.len()
+    );
+    if survivors.is_empty() {
+        Ok(())
+    } else {
+        Err(format!(
+            "mutants no test kills (add a test that tells each apart, or name it in \
+             xtask/src/mutants.rs EQUIVALENT with the reason):\n  {}",
+            survivors.join("\n  ")
+        ))
+    }
+}
+
+fn ensure_cargo_mutants() -> Result<(), String> {
+    let installed = Command::new("cargo")
+        .args(["mutants", "--version"])
+        .output()
+        .is_ok_and(|out| out.status.success());
+    if installed {
+        Ok(())
+    } else {
+        sh(Command::new("cargo").args(["install", "cargo-mutants", "--locked"]))
+    }
+}
