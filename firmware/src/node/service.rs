@@ -243,6 +243,22 @@ mod tests {
     }
 
     #[test]
+    fn send_all_counts_the_frames_the_port_took() {
+        let mut node = Node::new(Config::ROBOT).unwrap();
+        let stop = node.stop_frames();
+        let mut port = queues(&[]);
+        assert_eq!(send_all(&mut port, &stop).unwrap(), stop.len() as u32);
+        assert_eq!(port.tx.as_slice(), stop.as_slice());
+        let mut full = queues(&[]);
+        full.full_for = TX_TRIES;
+        assert_eq!(
+            send_all(&mut full, &stop).unwrap(),
+            stop.len() as u32 - 1,
+            "the first waits out every try"
+        );
+    }
+
+    #[test]
     fn transmit_sends_the_tick_s_frames_and_counts_a_full_queue() {
         let mut node = Node::new(Config::ROBOT).unwrap();
         let mut port = queues(&[]);
