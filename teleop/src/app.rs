@@ -106,6 +106,9 @@ impl App {
     /// Takes a frame seen on the bus at `now_ms`.
     pub fn observe(&mut self, now_ms: u64, frame: &Frame) {
         self.status.observe(now_ms, frame);
+        if let Some(controller) = self.status.controller(now_ms) {
+            self.operator.observe_controller(controller.mode);
+        }
     }
 
     /// Takes the in-process simulator's ground truth.

@@ -18,6 +18,10 @@ use teleop_core::scripted::ScriptedTeleop;
 /// How often the script services the bus.
 const SERVICE_PERIOD: Duration = Duration::from_millis(2);
 
+/// Most frames read per pass of the loop: 1,000 frames every 2 ms is far above any genuine
+/// bus, and a flood beyond it waits instead of starving the loop.
+const MAX_FRAMES_PER_PASS: usize = 1_000;
+
 /// Why a script failed.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -52,7 +56,13 @@ pub fn send(
 ) -> Result<ScriptReport, ScriptError> {
     let mut operator = Operator::new();
     operator.press(0, key);
-    serve(bus, hold, stop, |now_ms| operator.poll(now_ms))
+    serve(bus, hold, stop, |now_ms, controller| {
+        // An E-stop is sent again until the controller reports it.
+        if let Some(mode) = controller {
+            operator.observe_controller(mode);
+        }
+        operator.poll(now_ms)
+    })
 }
 
 /// Follows `scenario` from now until its `duration_s`; `on_step` is told each step as it
@@ -66,7 +76,7 @@ pub fn run(
     let mut teleop = ScriptedTeleop::new(scenario.plan());
     let mut started = 0;
     let hold = Duration::from_secs_f64(scenario.duration_s);
-    serve(bus, hold, stop, |now_ms| {
+    serve(bus, hold, stop, |now_ms, _| {
         let now_us = now_ms.saturating_mul(1_000);
         while scenario
             .steps
@@ -84,7 +94,7 @@ fn serve(
     bus: &mut dyn Bus,
     hold: Duration,
     stop: &AtomicBool,
-    mut frames_due: impl FnMut(u64) -> Result<Vec<Frame>, EncodeError>,
+    mut frames_due: impl FnMut(u64, Option<ControllerMode>) -> Result<Vec<Frame>, EncodeError>,
 ) -> Result<ScriptReport, ScriptError> {
     let start = Instant::now();
     let mut status = BusStatus::default();
@@ -96,11 +106,16 @@ fn serve(
     };
     loop {
         let now_ms = u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX);
-        for frame in frames_due(now_ms).map_err(ScriptError::Encode)? {
+        let controller = status.controller(now_ms).map(|c| c.mode);
+        for frame in frames_due(now_ms, controller).map_err(ScriptError::Encode)? {
             bus.send(&frame)?;
             report.frames_sent += 1;
         }
-        while let Some(frame) = bus.recv(Duration::ZERO)? {
+        // Bounded, so that a flood cannot keep this loop from sending (an E-stop included).
+        for _ in 0..MAX_FRAMES_PER_PASS {
+            let Some(frame) = bus.recv(Duration::ZERO)? else {
+                break;
+            };
             status.observe(now_ms, &frame);
             report.frames_heard += 1;
         }

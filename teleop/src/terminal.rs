@@ -16,6 +16,9 @@ const DRAW_PERIOD: Duration = Duration::from_millis(50);
 /// Longest wait for a key between two services of the bus.
 const KEY_WAIT: Duration = Duration::from_millis(2);
 
+/// Most frames read per pass of the loop (a pass takes a few ms): far above any genuine bus.
+const MAX_FRAMES_PER_PASS: usize = 1_000;
+
 /// Why the interactive session ended badly.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -78,7 +81,8 @@ fn serve(
                 errors.push(format!("send failed: {e}"));
             }
         }
-        loop {
+        // Bounded, so that a flood cannot keep the loop from reading keys (the E-stop included).
+        for _ in 0..MAX_FRAMES_PER_PASS {
             match bus.recv(Duration::ZERO) {
                 Ok(Some(frame)) => app.observe(now, &frame),
                 Ok(None) => break,

@@ -79,9 +79,20 @@ fn banners(app: &App, now_ms: u64) -> Vec<Line<'static>> {
         .bg(Color::Red)
         .add_modifier(Modifier::BOLD);
     let mut lines = Vec::new();
-    if app.operator().estop_latched() {
+    // What the controller reports, not only what this program asked for: a latch may be lost
+    // on the way (it is resent until confirmed), and another node may have latched one.
+    let controller_estop = app
+        .status()
+        .controller(now_ms)
+        .is_some_and(|status| status.mode == protocol::ControllerMode::EStop);
+    if controller_estop {
         lines.push(Line::styled(
-            " E-STOP LATCHED: the drives are torque-free. Press R twice to release. ",
+            " E-STOP LATCHED, confirmed by the controller: the drives stop. Press R twice to release. ",
+            alarm,
+        ));
+    } else if app.operator().estop_latched() {
+        lines.push(Line::styled(
+            " E-STOP SENT, not yet confirmed by the controller: sending it again every 4 ms. ",
             alarm,
         ));
     }

@@ -108,9 +108,35 @@ fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
             ..
         }))
     ));
+    // Not confirmed yet: the screen says so, and the latch goes out again every 4 ms.
     let shown = screen(&app, 12);
-    assert!(shown.contains("E-STOP LATCHED"), "{shown}");
+    assert!(shown.contains("E-STOP SENT, not yet confirmed"), "{shown}");
     assert!(shown.contains("command X stop"), "{shown}");
+    let again = decode_all(&app.poll(16).unwrap(), &mut rx);
+    assert!(
+        again.iter().any(|m| matches!(
+            m,
+            AnyMessage::EStop(EStop {
+                action: EStopAction::Latch,
+                ..
+            })
+        )),
+        "{again:?}"
+    );
+    // The controller reports it: the screen shows the controller's state, and the latch stops.
+    app.observe(
+        18,
+        &status(ControllerMode::EStop, FaultFlags::ESTOP_LATCHED),
+    );
+    let shown = screen(&app, 18);
+    assert!(shown.contains("E-STOP LATCHED, confirmed"), "{shown}");
+    for t in 19..60 {
+        let frames = decode_all(&app.poll(t).unwrap(), &mut rx);
+        assert!(
+            !frames.iter().any(|m| matches!(m, AnyMessage::EStop(_))),
+            "t {t}: {frames:?}"
+        );
+    }
 
     app.key(100, Key::Char('r'));
     assert!(screen(&app, 100).contains("press R again within 2 s"));
@@ -123,8 +149,12 @@ fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
             ..
         }))
     ));
-    let shown = screen(&app, 200);
-    assert!(!shown.contains("E-STOP LATCHED"), "{shown}");
+    app.observe(201, &status(ControllerMode::Stop, FaultFlags::EMPTY));
+    let shown = screen(&app, 201);
+    assert!(
+        !shown.contains("E-STOP LATCHED") && !shown.contains("E-STOP SENT"),
+        "{shown}"
+    );
     assert!(shown.contains("E-stop released"), "{shown}");
 
     app.key(300, Key::Char('z'));

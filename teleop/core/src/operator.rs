@@ -1,18 +1,22 @@
 //! The operator as a CAN node. It sends the teleop command whenever it changes and again every
 //! 20 ms, and a heartbeat every 20 ms, so the controller knows someone is at the keys: when
 //! the heartbeat stops (teleop quit or died) the controller stops the robot within 500 ms.
-//! Space latches an E-stop at once; releasing it takes `R` twice within 2 s, so that no single
-//! stray key does it.
+//! Space latches an E-stop at once, and the latch is sent again every 4 ms until the controller
+//! reports `EStop` (a single lost frame must not leave the robot moving); releasing it takes
+//! `R` twice within 2 s, so that no single stray key does it.
 
 use protocol::{
-    AnyMessage, BodyHeight, E2eCounter, EStop, EStopAction, EncodeError, Frame, Millis, NodeId,
-    SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode,
+    AnyMessage, BodyHeight, ControllerMode, E2eCounter, EStop, EStopAction, EncodeError, Frame,
+    Millis, NodeId, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode,
 };
 
 use crate::keys::Action;
 
 /// Period of the command and heartbeat, ms (50 Hz).
 pub const PERIOD_MS: u64 = 20;
+/// How often an unconfirmed E-stop latch is sent again, ms: one control period of the
+/// controller at 250 Hz, so that on a lossy link the latch gets through within a few of them.
+pub const LATCH_REPEAT_MS: u64 = 4;
 /// Window in which the second `R` releases the E-stop, ms.
 pub const RELEASE_WINDOW_MS: u64 = 2_000;
 /// Body-height range of the wire, m.
@@ -34,6 +38,10 @@ pub struct Operator {
     body_height_m: f32,
     speed_scale_pct: f32,
     estop_latched: bool,
+    /// Whether the controller has reported its E-stop since this operator's last latch.
+    estop_confirmed: bool,
+    /// When the latch was last sent (it is repeated until confirmed).
+    latch_sent_ms: Option<u64>,
     release_armed_at_ms: Option<u64>,
     pending_estop: Option<EStopAction>,
     command_changed: bool,
@@ -57,6 +65,8 @@ impl Operator {
             body_height_m: 0.0,
             speed_scale_pct: 100.0,
             estop_latched: false,
+            estop_confirmed: false,
+            latch_sent_ms: None,
             release_armed_at_ms: None,
             pending_estop: None,
             command_changed: true,
@@ -85,6 +95,20 @@ impl Operator {
     /// Whether this operator latched an E-stop that is not yet released.
     pub fn estop_latched(&self) -> bool {
         self.estop_latched
+    }
+
+    /// Whether the controller has reported its E-stop since this operator latched one: until it
+    /// has, the latch is repeated every [`LATCH_REPEAT_MS`].
+    pub fn estop_confirmed(&self) -> bool {
+        self.estop_confirmed
+    }
+
+    /// Takes the controller's reported mode (from its status frames): an `EStop` confirms a
+    /// latch this operator sent.
+    pub fn observe_controller(&mut self, mode: ControllerMode) {
+        if self.estop_latched && mode == ControllerMode::EStop {
+            self.estop_confirmed = true;
+        }
     }
 
     /// Whether one `R` has been pressed and a second within the window would release.
@@ -118,6 +142,7 @@ impl Operator {
             }
             Action::EStop => {
                 self.estop_latched = true;
+                self.estop_confirmed = false;
                 self.pending_estop = Some(EStopAction::Latch);
                 // After a stop, motion must be asked for again.
                 self.mode = TeleopMode::Stop;
@@ -128,6 +153,8 @@ impl Operator {
                     self.release_armed_at_ms = None;
                     if self.estop_latched {
                         self.estop_latched = false;
+                        self.estop_confirmed = false;
+                        self.latch_sent_ms = None;
                         self.pending_estop = Some(EStopAction::Clear);
                     }
                 } else {
@@ -139,11 +166,24 @@ impl Operator {
         Outcome::Continue
     }
 
-    /// The frames due at `now_ms`: an E-stop latch or clear at once, the command at once when it
-    /// changed, and the command and heartbeat every [`PERIOD_MS`].
+    /// The frames due at `now_ms`: an E-stop latch or clear at once (a latch again every
+    /// [`LATCH_REPEAT_MS`] until the controller confirms it: a lost latch frame must not leave
+    /// the robot moving), the command at once when it changed, and the command and heartbeat
+    /// every [`PERIOD_MS`].
     pub fn poll(&mut self, now_ms: u64) -> Result<Vec<Frame>, EncodeError> {
         let mut frames = Vec::with_capacity(3);
+        let repeat_latch = self.estop_latched
+            && !self.estop_confirmed
+            && self
+                .latch_sent_ms
+                .is_some_and(|sent| now_ms.saturating_sub(sent) >= LATCH_REPEAT_MS);
+        if repeat_latch && self.pending_estop.is_none() {
+            self.pending_estop = Some(EStopAction::Latch);
+        }
         if let Some(action) = self.pending_estop.take() {
+            if action == EStopAction::Latch {
+                self.latch_sent_ms = Some(now_ms);
+            }
             let estop = AnyMessage::EStop(EStop {
                 action,
                 source: NodeId::Teleop,
