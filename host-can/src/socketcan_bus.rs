@@ -155,7 +155,9 @@ impl Bus for SocketCanBus {
             // poll(2) counts whole milliseconds: a shorter wait would poll with 0 and spin a
             // core until the deadline, so it sleeps instead and then looks once.
             let poll_for = if left < Duration::from_millis(1) {
-                std::thread::sleep(left);
+                if !left.is_zero() {
+                    std::thread::sleep(left);
+                }
                 Duration::ZERO
             } else {
                 left

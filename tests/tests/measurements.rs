@@ -21,20 +21,32 @@ fn steps_per_s(summary: &serde_json::Value) -> f64 {
 fn lockstep_over_vcan_keeps_at_least_half_the_in_process_speed() {
     let _alone = one_at_a_time();
     let w = scenario("w.toml");
-    let inproc_out = out_dir("speed-inproc");
-    let status =
-        start_sim("inproc", &inproc_out, &["--scenario", &w]).wait(Duration::from_secs(600));
-    assert!(status.success());
-    let inproc: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(inproc_out.join("summary.json")).unwrap())
-            .unwrap();
-    let bus = Vcan::new();
-    let fw = firmware(&bus);
-    let vcan = simulate(&bus, &out_dir("speed-vcan"), &["--scenario", &w]).expect("summary");
-    let _ = fw.terminate();
-    let (a, b) = (steps_per_s(&inproc), steps_per_s(&vcan));
+    // Two rounds, in-process then vcan, and the best of each: a ratio of speeds on a shared,
+    // emulated machine must not hinge on one moment of contention.
+    let mut best = (0.0_f64, 0.0_f64);
+    for round in 0..2 {
+        let inproc_out = out_dir(&format!("speed-inproc-{round}"));
+        let status =
+            start_sim("inproc", &inproc_out, &["--scenario", &w]).wait(Duration::from_secs(600));
+        assert!(status.success());
+        let inproc: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(inproc_out.join("summary.json")).unwrap(),
+        )
+        .unwrap();
+        let bus = Vcan::new();
+        let fw = firmware(&bus);
+        let out = out_dir(&format!("speed-vcan-{round}"));
+        let vcan = simulate(&bus, &out, &["--scenario", &w]).expect("summary");
+        let _ = fw.terminate();
+        best = (
+            best.0.max(steps_per_s(&inproc)),
+            best.1.max(steps_per_s(&vcan)),
+        );
+    }
+    let (a, b) = best;
     println!(
-        "MEASURED lockstep speed: in-process {a:.0} steps/s, vcan {b:.0} steps/s, ratio {:.2}",
+        "MEASURED lockstep speed (best of 2 rounds): in-process {a:.0} steps/s, vcan {b:.0} \
+         steps/s, ratio {:.2}",
         b / a
     );
     assert!(b >= 0.5 * a, "vcan {b:.0} steps/s vs in-process {a:.0}");
