@@ -3,8 +3,8 @@
 //!
 //! `embedded-can`'s non-blocking `receive` answers "nothing now" with `WouldBlock`; a host
 //! port may first wait for a frame, as the runner's clocks need: not at all (take what is
-//! there), up to a timeout per frame (lockstep, waiting for the simulator), or until a
-//! deadline (the next tick of a wall-clock runner).
+//! there) or until a deadline (the next tick of a wall-clock runner, or the end of one
+//! lockstep wait for the simulator, after which the runner looks at its stop flag).
 
 use std::time::{Duration, Instant};
 
@@ -18,8 +18,6 @@ use crate::bus::{Bus, BusError};
 pub enum Wait {
     /// Not at all: only frames already there.
     Never,
-    /// Up to this long for each frame.
-    PerFrame(Duration),
     /// Until this instant; after it, not at all and no frame is taken.
     Until(Instant),
 }
@@ -51,7 +49,6 @@ impl<B: Bus + ?Sized> Can for BusPort<'_, B> {
     fn receive(&mut self) -> nb::Result<Frame, BusError> {
         let timeout = match self.wait {
             Wait::Never => Duration::ZERO,
-            Wait::PerFrame(timeout) => timeout,
             Wait::Until(deadline) => match deadline.checked_duration_since(Instant::now()) {
                 Some(left) if !left.is_zero() => left,
                 _ => return Err(nb::Error::WouldBlock),
@@ -84,7 +81,8 @@ mod tests {
         let frame = Frame::new(0x123, &[1, 2]).unwrap();
         let mut port_a = BusPort::new(&mut a, Wait::Never);
         assert!(matches!(port_a.transmit(&frame), Ok(None)));
-        let mut port_b = BusPort::new(&mut b, Wait::PerFrame(Duration::from_millis(1)));
+        let soon = Instant::now() + Duration::from_millis(1);
+        let mut port_b = BusPort::new(&mut b, Wait::Until(soon));
         assert!(matches!(port_b.receive(), Ok(f) if f == frame));
         assert!(matches!(port_b.receive(), Err(nb::Error::WouldBlock)));
         let past = Instant::now();

@@ -80,27 +80,6 @@ impl<T> Joints<T> {
         &self.0
     }
 
-    /// The values in joint order, to change.
-    pub fn as_mut_array(&mut self) -> &mut [T; 16] {
-        &mut self.0
-    }
-
-    /// The values in joint order.
-    pub fn into_array(self) -> [T; 16] {
-        self.0
-    }
-
-    /// Each leg's four values, legs in [`Leg::ALL`] order.
-    pub fn into_legs(self) -> [[T; 4]; 4] {
-        let [a0, a1, a2, a3, b0, b1, b2, b3, c0, c1, c2, c3, d0, d1, d2, d3] = self.0;
-        [
-            [a0, a1, a2, a3],
-            [b0, b1, b2, b3],
-            [c0, c1, c2, c3],
-            [d0, d1, d2, d3],
-        ]
-    }
-
     /// The value at `index` in joint order, `None` past the last joint.
     pub fn get(&self, index: usize) -> Option<&T> {
         self.0.get(index)
@@ -260,11 +239,6 @@ impl<T> PerDrive<T> {
         &self.0
     }
 
-    /// The values in [`Drive::ALL`] order.
-    pub fn into_array(self) -> [T; 5] {
-        self.0
-    }
-
     /// The value of `drive`.
     pub fn get(&self, drive: Drive) -> &T {
         let [fl, fr, bl, br, wheel] = &self.0;
@@ -356,7 +330,6 @@ mod tests {
             names.leg(Leg::Fr),
             &["hip1_fr", "hip2_fr", "knee_fr", "ankle_fr"]
         );
-        assert_eq!(Joints::from_legs(names.into_legs()), names);
         assert_eq!(Joints::from_leg_fn(|leg| *names.leg(leg)), names);
         assert_eq!(names.get(16), None);
     }
@@ -389,7 +362,7 @@ mod tests {
             assert_eq!(*drives.get(drive), drive as u8);
             *drives.get_mut(drive) += 10;
         }
-        assert_eq!(drives.into_array(), [10, 11, 12, 13, 14]);
+        assert_eq!(<[u8; 5]>::from(drives), [10, 11, 12, 13, 14]);
         let order: [Drive; 5] = PerDrive::from_fn(|d| d).into();
         assert_eq!(order, Drive::ALL);
     }

@@ -199,6 +199,21 @@ pub fn firmware(bus: &Vcan) -> Process {
     )
 }
 
+/// The firmware on its own wall clock at 250 Hz on `bus`, as on the microcontroller.
+pub fn firmware_on_wall_clock(bus: &Vcan) -> Process {
+    Process::start(
+        "firmware-host",
+        &[
+            "--bus",
+            bus.name(),
+            "--clock",
+            "wall",
+            "--control-hz",
+            "250",
+        ],
+    )
+}
+
 /// Starts `sim-host run` on `bus` (an interface, or `inproc`) writing to `out`, without plots
 /// or progress bar, with `args` added.
 ///

@@ -6,8 +6,8 @@
 use std::time::{Duration, Instant};
 
 use hil_tests::{
-    candump, candump_filtered, firmware, one_at_a_time, out_dir, read_candump, read_telemetry,
-    scenario, simulate, start_sim, wait_for_log, Process, Vcan,
+    candump, candump_filtered, firmware, firmware_on_wall_clock, one_at_a_time, out_dir,
+    read_candump, read_telemetry, scenario, simulate, start_sim, wait_for_log, Vcan,
 };
 use host_can::bus::Bus;
 use host_can::fault_plan::Faults;
@@ -210,17 +210,7 @@ fn a_10000_frames_per_second_teleop_flood_leaves_the_control_period_and_feedback
     // Everything but the flood itself: its frames are counted where they are made.
     let dump = candump_filtered(&bus, &log, ",200~7FF");
     std::thread::sleep(Duration::from_millis(200));
-    let fw = Process::start(
-        "firmware-host",
-        &[
-            "--bus",
-            bus.name(),
-            "--clock",
-            "wall",
-            "--control-hz",
-            "250",
-        ],
-    );
+    let fw = firmware_on_wall_clock(&bus);
     let out = out_dir("faults-flood-run");
     let sim = start_sim(bus.name(), &out, &["--clock", "wall", "--duration-s", "5"]);
     std::thread::sleep(Duration::from_millis(1000));

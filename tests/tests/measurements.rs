@@ -7,8 +7,8 @@
 use std::time::Duration;
 
 use hil_tests::{
-    candump, firmware, one_at_a_time, out_dir, read_candump, scenario, simulate, start_sim,
-    Process, Vcan,
+    candump, firmware, firmware_on_wall_clock, one_at_a_time, out_dir, read_candump, scenario,
+    simulate, start_sim, Vcan,
 };
 use protocol::busload::{bus_load, fd_frame_bits, ROBOT_BUS};
 use protocol::MessageId;
@@ -105,17 +105,7 @@ fn real_time_control_period_jitter_and_feedback_to_command_latency() {
     let log = out_dir("jitter").with_extension("log");
     let dump = candump(&bus, &log);
     std::thread::sleep(Duration::from_millis(200));
-    let fw = Process::start(
-        "firmware-host",
-        &[
-            "--bus",
-            bus.name(),
-            "--clock",
-            "wall",
-            "--control-hz",
-            "250",
-        ],
-    );
+    let fw = firmware_on_wall_clock(&bus);
     let out = out_dir("jitter-run");
     let status = start_sim(bus.name(), &out, &["--clock", "wall", "--duration-s", "3"])
         .wait(Duration::from_secs(600));

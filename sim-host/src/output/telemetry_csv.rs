@@ -43,15 +43,6 @@ pub fn header() -> Vec<String> {
         .collect()
 }
 
-/// Writes `rows` to `path` (created or truncated) under [`header`]; see [`CsvWriter`].
-pub fn write_csv(path: &Path, rows: &[TelemetryRow]) -> Result<(), OutputError> {
-    let mut writer = CsvWriter::create(path)?;
-    for row in rows {
-        writer.write(row)?;
-    }
-    writer.finish()
-}
-
 /// Telemetry rows streamed to a CSV file as a run goes. Numbers are written in their shortest
 /// exact decimal form (`NaN` and `inf` as such); the mode is its
 /// [`protocol::ControllerMode::label`], or empty before the first controller status. Rows are
@@ -125,11 +116,6 @@ impl CsvWriter {
     pub fn finish(mut self) -> Result<(), OutputError> {
         self.flush()
     }
-
-    /// The file written.
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
 }
 
 fn io_error(path: &Path, source: std::io::Error) -> OutputError {
@@ -142,6 +128,15 @@ fn io_error(path: &Path, source: std::io::Error) -> OutputError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `rows` through a [`CsvWriter`] into `path`.
+    fn write_csv(path: &Path, rows: &[TelemetryRow]) -> Result<(), OutputError> {
+        let mut writer = CsvWriter::create(path)?;
+        for row in rows {
+            writer.write(row)?;
+        }
+        writer.finish()
+    }
     use protocol::ControllerMode;
 
     fn row(time_s: f64, mode: Option<ControllerMode>) -> TelemetryRow {
