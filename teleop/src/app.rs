@@ -106,8 +106,11 @@ impl App {
     /// Takes a frame seen on the bus at `now_ms`.
     pub fn observe(&mut self, now_ms: u64, frame: &Frame) {
         self.status.observe(now_ms, frame);
-        if let Some(controller) = self.status.controller(now_ms) {
-            self.operator.observe_controller(controller.mode);
+        // Only a status frame heard now confirms an E-stop, never the one stored from before.
+        if frame.id() == protocol::MessageId::ControllerStatus.raw() {
+            if let Some(controller) = self.status.controller(now_ms) {
+                self.operator.observe_controller(controller.mode);
+            }
         }
     }
 

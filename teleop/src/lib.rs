@@ -9,6 +9,11 @@
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 #![deny(missing_docs, clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
+/// Most frames the program reads from the bus per pass of its loop (a pass takes a few ms):
+/// far above any genuine bus, so that a flood cannot keep the loop from reading keys or
+/// sending (the E-stop included).
+pub const MAX_FRAMES_PER_PASS: usize = 1_000;
+
 pub mod app;
 #[cfg(feature = "sim")]
 pub mod inproc;

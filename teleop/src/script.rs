@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use host_can::bus::{Bus, BusError};
-use protocol::{ControllerMode, EncodeError, Frame};
+use protocol::{ControllerMode, EncodeError, Frame, MessageId};
 use teleop_core::bus_status::BusStatus;
 use teleop_core::keys::Action;
 use teleop_core::operator::Operator;
@@ -17,10 +17,6 @@ use teleop_core::scripted::ScriptedTeleop;
 
 /// How often the script services the bus.
 const SERVICE_PERIOD: Duration = Duration::from_millis(2);
-
-/// Most frames read per pass of the loop: 1,000 frames every 2 ms is far above any genuine
-/// bus, and a flood beyond it waits instead of starving the loop.
-const MAX_FRAMES_PER_PASS: usize = 1_000;
 
 /// Why a script failed.
 #[derive(Debug, thiserror::Error)]
@@ -104,20 +100,24 @@ fn serve(
         last_mode: None,
         interrupted: false,
     };
+    // The controller's mode from a status frame heard since the last pass (not a stored one:
+    // a status from before an E-stop must not confirm it).
+    let mut heard = None;
     loop {
         let now_ms = u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX);
-        let controller = status.controller(now_ms).map(|c| c.mode);
-        for frame in frames_due(now_ms, controller).map_err(ScriptError::Encode)? {
+        for frame in frames_due(now_ms, heard.take()).map_err(ScriptError::Encode)? {
             bus.send(&frame)?;
             report.frames_sent += 1;
         }
-        // Bounded, so that a flood cannot keep this loop from sending (an E-stop included).
-        for _ in 0..MAX_FRAMES_PER_PASS {
+        for _ in 0..crate::MAX_FRAMES_PER_PASS {
             let Some(frame) = bus.recv(Duration::ZERO)? else {
                 break;
             };
             status.observe(now_ms, &frame);
             report.frames_heard += 1;
+            if frame.id() == MessageId::ControllerStatus.raw() {
+                heard = status.controller(now_ms).map(|c| c.mode).or(heard);
+            }
         }
         if let Some(controller) = status.controller(now_ms) {
             report.last_mode = Some(controller.mode);

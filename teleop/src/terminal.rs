@@ -16,9 +16,6 @@ const DRAW_PERIOD: Duration = Duration::from_millis(50);
 /// Longest wait for a key between two services of the bus.
 const KEY_WAIT: Duration = Duration::from_millis(2);
 
-/// Most frames read per pass of the loop (a pass takes a few ms): far above any genuine bus.
-const MAX_FRAMES_PER_PASS: usize = 1_000;
-
 /// Why the interactive session ended badly.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
@@ -81,8 +78,7 @@ fn serve(
                 errors.push(format!("send failed: {e}"));
             }
         }
-        // Bounded, so that a flood cannot keep the loop from reading keys (the E-stop included).
-        for _ in 0..MAX_FRAMES_PER_PASS {
+        for _ in 0..crate::MAX_FRAMES_PER_PASS {
             match bus.recv(Duration::ZERO) {
                 Ok(Some(frame)) => app.observe(now, &frame),
                 Ok(None) => break,

@@ -103,10 +103,11 @@ impl Operator {
         self.estop_confirmed
     }
 
-    /// Takes the controller's reported mode (from its status frames): an `EStop` confirms a
-    /// latch this operator sent.
+    /// Takes the controller's reported mode from a status frame just heard: an `EStop` confirms
+    /// a latch this operator has sent (a status heard before the latch went out confirms
+    /// nothing).
     pub fn observe_controller(&mut self, mode: ControllerMode) {
-        if self.estop_latched && mode == ControllerMode::EStop {
+        if self.estop_latched && self.latch_sent_ms.is_some() && mode == ControllerMode::EStop {
             self.estop_confirmed = true;
         }
     }
@@ -143,6 +144,7 @@ impl Operator {
             Action::EStop => {
                 self.estop_latched = true;
                 self.estop_confirmed = false;
+                self.latch_sent_ms = None;
                 self.pending_estop = Some(EStopAction::Latch);
                 // After a stop, motion must be asked for again.
                 self.mode = TeleopMode::Stop;
@@ -298,6 +300,40 @@ mod tests {
                 ..
             }))
         ));
+    }
+
+    #[test]
+    fn the_latch_repeats_until_a_status_heard_after_it_confirms_it() {
+        let mut op = Operator::new();
+        let latches = |frames: &[Frame]| {
+            frames
+                .iter()
+                .filter(|f| f.id() == MessageId::EStop.raw())
+                .count()
+        };
+        op.poll(0).unwrap();
+        op.press(10, Action::EStop);
+        // A status heard before the latch went out (the controller still in its old E-stop,
+        // say) confirms nothing.
+        op.observe_controller(ControllerMode::EStop);
+        assert!(!op.estop_confirmed());
+        assert_eq!(latches(&op.poll(10).unwrap()), 1);
+        assert_eq!(latches(&op.poll(12).unwrap()), 0, "not before 4 ms");
+        assert_eq!(latches(&op.poll(14).unwrap()), 1, "again after 4 ms");
+        op.observe_controller(ControllerMode::Stop);
+        assert_eq!(
+            latches(&op.poll(18).unwrap()),
+            1,
+            "another mode confirms nothing"
+        );
+        op.observe_controller(ControllerMode::EStop);
+        assert!(op.estop_confirmed());
+        assert_eq!(
+            (19..100)
+                .map(|t| latches(&op.poll(t).unwrap()))
+                .sum::<usize>(),
+            0
+        );
     }
 
     #[test]
