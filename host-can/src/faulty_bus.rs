@@ -13,7 +13,7 @@
 use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
-use protocol::{decode_frame, AnyMessage, E2eCounter, Frame, MessageId};
+use protocol::{decode_frame, AnyMessage, Frame, Key, MessageId, Session, TEST_KEY};
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 
@@ -61,7 +61,9 @@ struct Injector {
     /// frame in between, or two old frames in a row would look like a restarted sender.
     replayed_last: Vec<u16>,
     flood_template: Option<AnyMessage>,
-    flood_counter: Option<E2eCounter>,
+    flood_counter: Option<u32>,
+    /// The session the flood's copies are sealed in: the one the node's bus announced.
+    session: Session,
     /// With [`FaultPlan::burst_cycles`]: whether this cycle is inside a loss burst.
     in_burst: bool,
     stats: FaultStats,
@@ -80,6 +82,7 @@ impl Injector {
             replayed_last: Vec::new(),
             flood_template: None,
             flood_counter: None,
+            session: Session::unjoined(TEST_KEY),
             in_burst: false,
             stats: FaultStats::default(),
             bad_by_id: BTreeMap::new(),
@@ -247,7 +250,8 @@ impl Injector {
     }
 
     /// With a flood planned, the layer owns the TeleopCommand counter: the node's own commands
-    /// and the flood's copies form one sequence, as a babbling teleop's would.
+    /// and the flood's copies form one sequence, sealed with the node's key in the session the
+    /// bus announced, as a babbling teleop's would.
     fn flood_sequence(&mut self, frame: Frame) -> Frame {
         if self.plan.flood_per_cycle == 0 || frame.id() != MessageId::TeleopCommand.raw() {
             return frame;
@@ -255,11 +259,11 @@ impl Injector {
         let Ok(decoded) = decode_frame(frame.id(), frame.data()) else {
             return frame;
         };
-        let counter = self
-            .flood_counter
-            .get_or_insert(E2eCounter::starting_at(decoded.counter));
+        let counter = self.flood_counter.get_or_insert(u32::from(decoded.counter));
         self.flood_template = Some(decoded.message);
-        decoded.message.encode(counter.advance()).unwrap_or(frame)
+        let sealed = decoded.message.encode(&self.session, *counter);
+        *counter = counter.wrapping_add(1);
+        sealed.unwrap_or(frame)
     }
 
     /// The flood's frames for one cycle.
@@ -269,7 +273,9 @@ impl Injector {
             return;
         };
         for _ in 0..self.plan.flood_per_cycle {
-            if let Ok(frame) = message.encode(counter.advance()) {
+            let sealed = message.encode(&self.session, *counter);
+            *counter = counter.wrapping_add(1);
+            if let Ok(frame) = sealed {
                 self.stats.flooded += 1;
                 self.queue.push_back((cycle, frame));
             }
@@ -285,6 +291,7 @@ pub struct FaultyBus<B> {
     rx: Injector,
     cycle: u64,
     name: String,
+    key: Key,
 }
 
 impl<B: Bus> FaultyBus<B> {
@@ -297,6 +304,26 @@ impl<B: Bus> FaultyBus<B> {
             rx: Injector::new(faults.rx.clone(), faults.seed.wrapping_add(0x9E37_79B9)),
             cycle: 0,
             name,
+            key: TEST_KEY,
+        }
+    }
+
+    /// Seals the flood's copies with `key` (the test key by default).
+    #[must_use]
+    pub fn with_key(mut self, key: Key) -> Self {
+        self.key = key;
+        self
+    }
+
+    /// Follows the session the controller announces, for the flood's copies.
+    fn observe(&mut self, frame: &Frame) {
+        if frame.id() != MessageId::Announce.raw() {
+            return;
+        }
+        if let Ok(decoded) = decode_frame(frame.id(), frame.data()) {
+            if let AnyMessage::Announce(announce) = decoded.message {
+                self.tx.session = Session::owned(self.key, announce.epoch);
+            }
         }
     }
 
@@ -372,6 +399,7 @@ impl<B: Bus> Bus for FaultyBus<B> {
         let deadline = Instant::now() + timeout;
         loop {
             if let Some(frame) = self.rx.pop(self.cycle) {
+                self.observe(&frame);
                 if frame.id() == MessageId::Sync.raw() {
                     self.close_cycle();
                     self.flush_tx()?;

@@ -120,7 +120,7 @@ const fn slot(id: MessageId, period: Period, phase: u32) -> Slot {
 /// The frames of the control loop. The balance loop (wheels, IMU) runs every cycle; the leg
 /// drives servo locally, so their targets and feedback run at 250 Hz, spread over cycles;
 /// status and operator traffic run at 50 Hz and 10 Hz in the remaining cycles.
-pub const SCHEDULE: [Slot; 19] = [
+pub const SCHEDULE: [Slot; 20] = [
     slot(MessageId::EStop, Period::Sporadic, 0),
     Slot {
         id: MessageId::Sync,
@@ -140,6 +140,7 @@ pub const SCHEDULE: [Slot; 19] = [
     slot(MessageId::TeleopHeartbeat, Period::Hz(50), 7),
     slot(MessageId::ControllerStatus, Period::Hz(50), 11),
     slot(MessageId::RejectCounters, Period::Hz(10), 15),
+    slot(MessageId::Announce, Period::Hz(10), 39),
     slot(MessageId::DriveStatus(Drive::LegFl), Period::Hz(10), 19),
     slot(MessageId::DriveStatus(Drive::LegFr), Period::Hz(10), 23),
     slot(MessageId::DriveStatus(Drive::LegBl), Period::Hz(10), 27),

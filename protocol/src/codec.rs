@@ -5,10 +5,11 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use crate::dlc::{fd_padded_len, MAX_FD_LEN};
-use crate::e2e::{self, HEADER_LEN};
+use crate::e2e::{self, Check, Freshness, Protection, HEADER_LEN};
 use crate::error::DecodeError;
 use crate::frame::Frame;
 use crate::id::MessageId;
+use crate::session::Session;
 use crate::signal::Field;
 
 /// A message of the bus: its layout, name and where it may be sent.
@@ -33,8 +34,22 @@ pub trait Message: Serialize + DeserializeOwned + MaxSize + Sized {
         None => MAX_FD_LEN,
     };
 
+    /// How this message is protected (see [`crate::session`]): a CRC bound to the session
+    /// unless the message says otherwise.
+    const PROTECTION: Protection = Protection {
+        check: Check::Crc,
+        bound: true,
+        sequenced: true,
+    };
+
     /// The identifier this message goes out on.
     fn id(address: Self::Address) -> MessageId;
+
+    /// The protection of this value and how many payload bytes its check covers (all of them
+    /// unless the message says otherwise: an E-stop latch covers two).
+    fn protection(&self) -> (Protection, usize) {
+        (Self::PROTECTION, Self::POSTCARD_MAX_SIZE)
+    }
 }
 
 /// Declares the compile-time checks of a message layout: the payload fits a CAN FD frame, and
@@ -56,22 +71,33 @@ macro_rules! check_layout {
 }
 pub(crate) use check_layout;
 
-/// Why a message could not be encoded. Cannot happen for the messages of this crate (their
-/// sizes are checked at compile time); reported rather than assumed.
+/// Why a message could not be encoded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum EncodeError {
-    /// The serializer ran out of room.
+    /// The serializer ran out of room. Cannot happen for the messages of this crate (their
+    /// sizes are checked at compile time); reported rather than assumed.
     TooLarge,
+    /// The message is bound to a session and the sender has not joined one: it has not heard
+    /// the controller's announcement yet.
+    NoSession,
 }
 
-/// Encodes `message` for `address` with rolling counter `counter` into a padded CAN FD frame.
+/// Encodes `message` for `address` with the sender's full counter `counter` into a padded CAN
+/// FD frame, protected as the message requires under `session`.
 pub fn encode<M: Message>(
     message: &M,
     address: M::Address,
-    counter: u16,
+    session: &Session,
+    counter: u32,
 ) -> Result<Frame, EncodeError> {
     let id = M::id(address);
+    let (protection, covered) = message.protection();
+    let epoch = if protection.bound {
+        Some(session.epoch().ok_or(EncodeError::NoSession)?)
+    } else {
+        None
+    };
     let mut buf = [0_u8; MAX_FD_LEN];
     let payload = buf
         .get_mut(HEADER_LEN..M::LEN)
@@ -80,11 +106,23 @@ pub fn encode<M: Message>(
     if written.len() != M::POSTCARD_MAX_SIZE {
         return Err(EncodeError::TooLarge);
     }
+    let freshness = Freshness {
+        data_id: id.data_id(),
+        epoch,
+        counter: if protection.sequenced {
+            counter
+        } else {
+            counter & 0xFFFF
+        },
+    };
     e2e::protect(
-        id.data_id(),
-        counter,
-        buf.get_mut(..M::LEN).ok_or(EncodeError::TooLarge)?,
-    );
+        protection.check,
+        session.key(),
+        &freshness,
+        buf.get_mut(..HEADER_LEN + covered)
+            .ok_or(EncodeError::TooLarge)?,
+    )
+    .ok_or(EncodeError::TooLarge)?;
     Frame::new(
         id.raw(),
         buf.get(..M::WIRE_LEN).ok_or(EncodeError::TooLarge)?,
@@ -92,26 +130,21 @@ pub fn encode<M: Message>(
     .ok_or(EncodeError::TooLarge)
 }
 
-/// Decodes the data of a frame on `id` as `M`: length, CRC and value ranges are checked; the
-/// rolling counter is returned for the caller's sequence check.
+/// Parses the data of a frame on `id` as `M`: length and value ranges are checked and the
+/// header's low counter returned. The check value is **not** verified here — that needs the
+/// session and the sequence, which [`Receiver`](crate::Receiver) holds.
 pub fn decode<M: Message>(id: MessageId, data: &[u8]) -> Result<(M, u16), DecodeError> {
     let raw = id.raw();
-    if data.len() != M::WIRE_LEN {
-        return Err(DecodeError::WrongLength {
-            id: raw,
-            expected: M::WIRE_LEN,
-            got: data.len(),
-        });
-    }
-    let message = data.get(..M::LEN).ok_or(DecodeError::WrongLength {
+    let wrong_length = DecodeError::WrongLength {
         id: raw,
         expected: M::WIRE_LEN,
         got: data.len(),
-    })?;
-    let counter = e2e::verify(id.data_id(), message).ok_or(DecodeError::CrcMismatch { id: raw })?;
-    let payload = message
-        .get(HEADER_LEN..)
-        .ok_or(DecodeError::CrcMismatch { id: raw })?;
+    };
+    if data.len() != M::WIRE_LEN {
+        return Err(wrong_length);
+    }
+    let (_, counter) = e2e::header(data).ok_or(wrong_length)?;
+    let payload = data.get(HEADER_LEN..M::LEN).ok_or(wrong_length)?;
     // The length is fixed and checked, so the only way postcard fails here is a field's own
     // range check (an out-of-range scalar, unknown enumeration value or flag bit).
     let value =

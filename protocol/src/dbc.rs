@@ -2,7 +2,8 @@
 //! tools (candump + cantools, SavvyCAN, Wireshark) read the bus without this crate.
 //!
 //! Every message is a CAN FD frame with bit-rate switch (`VFrameFormat` = `StandardCAN_FD`).
-//! The E2E header appears as the signals `E2E_CRC` and `E2E_Counter`; flag fields appear as
+//! The E2E header appears as the signals `E2E_Check` and `E2E_Counter` (their comments say
+//! what the check covers); flag fields appear as
 //! one 1-bit signal per flag; enumerations carry value tables.
 
 use core::fmt::{self, Write};
@@ -33,6 +34,18 @@ pub fn write_dbc<W: Write>(out: &mut W) -> fmt::Result {
     )?;
     for id in MessageId::ALL {
         writeln!(out, "CM_ BO_ {} \"{}\";", id.raw(), id.layout().doc)?;
+        writeln!(
+            out,
+            "CM_ SG_ {} E2E_Check \"{}\";",
+            id.raw(),
+            check_comment(id)
+        )?;
+        writeln!(
+            out,
+            "CM_ SG_ {} E2E_Counter \"Low 16 bits of the sender's 32-bit counter on this id; \
+             the check covers the full counter\";",
+            id.raw()
+        )?;
     }
     out.write_str(
         "BA_DEF_ BO_ \"VFrameFormat\" ENUM \"StandardCAN\",\"ExtendedCAN\",\"reserved\",\"reserved\",\
@@ -54,10 +67,33 @@ pub fn write_dbc<W: Write>(out: &mut W) -> fmt::Result {
     Ok(())
 }
 
+/// What the check value of a message is, for the DBC's signal comment.
+const fn check_comment(id: MessageId) -> &'static str {
+    match id {
+        MessageId::EStop => {
+            "Latch: CRC-32C over data id, zero epoch, low counter, action and source (no session). \
+             Release: CMAC-AES-128 truncated to 32 bits over data id, session epoch, full counter \
+             and payload; must echo ControllerStatus.release_token"
+        }
+        MessageId::Announce => {
+            "CMAC-AES-128 truncated to 32 bits over data id, zero epoch, low counter and payload"
+        }
+        _ => match id.layout().protection.check {
+            crate::e2e::Check::Mac => {
+                "CMAC-AES-128 truncated to 32 bits over data id, session epoch, full counter and \
+                 payload (authenticated command)"
+            }
+            crate::e2e::Check::Crc => {
+                "CRC-32C over data id, session epoch, full counter and payload"
+            }
+        },
+    }
+}
+
 /// Nodes that act on a message (the DBC's receivers).
 const fn receivers(id: MessageId) -> &'static [NodeId] {
     match id {
-        MessageId::EStop => &[
+        MessageId::EStop | MessageId::Announce => &[
             NodeId::Controller,
             NodeId::LegDriveFl,
             NodeId::LegDriveFr,
@@ -99,11 +135,22 @@ fn write_message<W: Write>(out: &mut W, id: MessageId) -> fmt::Result {
         id.sender().name()
     )?;
     let rx = receivers(id);
-    write_signal(out, "E2E_CRC", 0, 16, false, 0, 0, u16::MAX.into(), "", rx)?;
+    write_signal(
+        out,
+        "E2E_Check",
+        0,
+        32,
+        false,
+        0,
+        0,
+        u32::MAX.into(),
+        "",
+        rx,
+    )?;
     write_signal(
         out,
         "E2E_Counter",
-        16,
+        32,
         16,
         false,
         0,

@@ -1,62 +1,142 @@
-//! End-to-end protection in the style of AUTOSAR E2E profile 5: every frame carries a CRC and a
-//! rolling counter in front of its payload.
+//! End-to-end protection: every frame carries a check value and the low half of a rolling
+//! counter in front of its payload, in the manner of AUTOSAR E2E and SecOC.
 //!
-//! | byte      | field                                                                     |
-//! |-----------|---------------------------------------------------------------------------|
-//! | 0–1       | CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF), little-endian              |
-//! | 2–3       | rolling counter, `u16` little-endian, +1 per frame sent on this id, wraps |
-//! | 4…        | payload (postcard, fixed-width integers)                                   |
-//! | after     | zero padding up to the CAN FD data length (not covered by the CRC)         |
+//! | byte      | field                                                                       |
+//! |-----------|-----------------------------------------------------------------------------|
+//! | 0–3       | check value, `u32` little-endian: CRC-32C or truncated CMAC-AES-128 ([`Check`]) |
+//! | 4–5       | rolling counter, low 16 bits of the sender's 32-bit counter on this id      |
+//! | 6…        | payload (postcard, fixed-width integers)                                     |
+//! | after     | zero padding up to the CAN FD data length (not covered by the check)        |
 //!
-//! The CRC covers bytes 2… of the message (counter and payload) followed by the identifier's
-//! data id ([`MessageId::data_id`](crate::MessageId::data_id)), low byte first. The data id is
-//! never sent: a frame that lands on another identifier fails its CRC.
+//! The check value covers, in this order: the identifier's data id
+//! ([`MessageId::data_id`](crate::MessageId::data_id), `u16`), the session epoch (`u32`, zero
+//! for a frame bound to no session), the sender's **full** counter (`u32`) and the payload, all
+//! little-endian. Neither the data id, the epoch nor the counter's high half is sent: the
+//! receiver supplies them, so a frame moved to another identifier, replayed from another
+//! session, or replayed from 2^16 frames ago fails its check (see [`crate::session`]).
 //!
-//! The counter is 16 bits (profile 5 has 8) so that at 1 kHz a replayed frame must be at least
-//! 65 s old to fall inside the receiver's window by wrap-around.
+//! A CMAC is the first four bytes of the 16-byte tag, read little-endian; CRC-32C is
+//! Castagnoli's polynomial (0x1EDC6F41, reflected, init and xor-out 0xFFFFFFFF).
 
-use crc::{Crc, CRC_16_IBM_3740};
+use aes::Aes128;
+use cmac::{Cmac, Mac};
+use crc::{Crc, CRC_32_ISCSI};
+
+use crate::session::{Epoch, Key};
 
 /// Bytes of E2E header in front of every payload.
-pub const HEADER_LEN: usize = 4;
+pub const HEADER_LEN: usize = 6;
 
-const CRC16: Crc<u16> = Crc::<u16>::new(&CRC_16_IBM_3740);
+const CRC32C: Crc<u32> = Crc::<u32>::new(&CRC_32_ISCSI);
 
-/// CRC of the protected bytes (counter and payload) and the data id.
-pub fn crc(data_id: u16, protected: &[u8]) -> u16 {
-    let mut digest = CRC16.digest();
-    digest.update(protected);
-    digest.update(&data_id.to_le_bytes());
-    digest.finalize()
+/// Which check value a frame carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Check {
+    /// CRC-32C: detects corruption; anyone can compute it.
+    Crc,
+    /// CMAC-AES-128 truncated to 32 bits: only a holder of the key can compute it.
+    Mac,
 }
 
-/// Writes counter and CRC into the first [`HEADER_LEN`] bytes of `message`, whose payload is
-/// already in place after them. Does nothing if `message` is shorter than the header.
-pub fn protect(data_id: u16, counter: u16, message: &mut [u8]) {
-    if let Some(counter_bytes) = message.get_mut(2..HEADER_LEN) {
-        counter_bytes.copy_from_slice(&counter.to_le_bytes());
-    }
-    let Some(protected) = message.get(2..) else {
-        return;
-    };
-    let checksum = crc(data_id, protected);
-    if let Some(crc_bytes) = message.get_mut(..2) {
-        crc_bytes.copy_from_slice(&checksum.to_le_bytes());
+/// How a frame is protected: its check value and whether it is bound to the session.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Protection {
+    /// The check value.
+    pub check: Check,
+    /// Whether the check covers the session epoch (and so needs one to send or receive).
+    pub bound: bool,
+    /// Whether the frame takes part in its identifier's counter sequence. A frame outside it
+    /// (the E-stop latch, the announcement) is checked at its low counter alone, with high
+    /// half zero, so that a constant frame stays valid.
+    pub sequenced: bool,
+}
+
+/// An authenticated command: CMAC bound to the session.
+pub const AUTHENTICATED: Protection = Protection {
+    check: Check::Mac,
+    bound: true,
+    sequenced: true,
+};
+
+/// The values a check covers besides the payload.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Freshness {
+    /// The identifier's data id.
+    pub data_id: u16,
+    /// The session epoch, or `None` for a frame bound to no session.
+    pub epoch: Option<Epoch>,
+    /// The sender's full counter.
+    pub counter: u32,
+}
+
+impl Freshness {
+    fn bytes(&self) -> [u8; 10] {
+        let mut out = [0; 10];
+        let epoch: u32 = self.epoch.map_or(0, Epoch::raw);
+        for (slot, byte) in out.iter_mut().zip(
+            self.data_id
+                .to_le_bytes()
+                .into_iter()
+                .chain(epoch.to_le_bytes())
+                .chain(self.counter.to_le_bytes()),
+        ) {
+            *slot = byte;
+        }
+        out
     }
 }
 
-/// The counter of a message whose CRC matches, or `None` if it does not (or the message is
-/// shorter than the header).
-pub fn verify(data_id: u16, message: &[u8]) -> Option<u16> {
-    let (crc_bytes, protected) = (message.get(..2)?, message.get(2..)?);
-    let sent = u16::from_le_bytes([*crc_bytes.first()?, *crc_bytes.get(1)?]);
-    if sent != crc(data_id, protected) {
-        return None;
+/// The check value of `payload` under `freshness`.
+pub fn check_value(check: Check, key: &Key, freshness: &Freshness, payload: &[u8]) -> u32 {
+    let prefix = freshness.bytes();
+    match check {
+        Check::Crc => {
+            let mut digest = CRC32C.digest();
+            digest.update(&prefix);
+            digest.update(payload);
+            digest.finalize()
+        }
+        Check::Mac => {
+            let mut mac = <Cmac<Aes128> as cmac::digest::KeyInit>::new(&key.0.into());
+            mac.update(&prefix);
+            mac.update(payload);
+            let tag = mac.finalize().into_bytes();
+            let mut first = [0; 4];
+            for (slot, byte) in first.iter_mut().zip(tag.iter()) {
+                *slot = *byte;
+            }
+            u32::from_le_bytes(first)
+        }
     }
-    Some(u16::from_le_bytes([
-        *protected.first()?,
-        *protected.get(1)?,
-    ]))
+}
+
+/// Writes check value and counter into the first [`HEADER_LEN`] bytes of `message`, whose
+/// payload is already in place after them. Does nothing if `message` is shorter than the
+/// header.
+pub fn protect(check: Check, key: &Key, freshness: &Freshness, message: &mut [u8]) -> Option<()> {
+    let low = (freshness.counter & 0xFFFF) as u16;
+    message
+        .get_mut(4..HEADER_LEN)?
+        .copy_from_slice(&low.to_le_bytes());
+    let value = check_value(check, key, freshness, message.get(HEADER_LEN..)?);
+    message.get_mut(..4)?.copy_from_slice(&value.to_le_bytes());
+    Some(())
+}
+
+/// The header of a received message: its check value and low counter, or `None` if the
+/// message is shorter than the header.
+pub fn header(message: &[u8]) -> Option<(u32, u16)> {
+    let check = message.get(..4)?;
+    let low = message.get(4..HEADER_LEN)?;
+    Some((
+        u32::from_le_bytes([
+            *check.first()?,
+            *check.get(1)?,
+            *check.get(2)?,
+            *check.get(3)?,
+        ]),
+        u16::from_le_bytes([*low.first()?, *low.get(1)?]),
+    ))
 }
 
 /// What the receiver concludes about one frame of a sequence.
@@ -64,21 +144,20 @@ pub fn verify(data_id: u16, message: &[u8]) -> Option<u16> {
 pub enum E2eStatus {
     /// The next frame in sequence. Accept.
     Ok,
-    /// In sequence after `lost` missing frames (within the tolerated gap). Accept.
+    /// In sequence after `lost` missing frames. Accept.
     OkSomeLost {
         /// Frames missing since the previous accepted one.
-        lost: u16,
+        lost: u32,
     },
-    /// First frame seen, or the sender restarted and two consecutive frames confirmed its new
-    /// sequence. Accept.
+    /// First frame of this sender in the session. Accept.
     Initial,
-    /// Same counter as the previous frame: a duplicate or a replay. Reject.
+    /// Same counter as the previous frame, and a valid check: a duplicate or a replay. Reject.
     Repeated,
-    /// Counter outside the tolerated window: stale, replayed, reordered or a restarted sender's
-    /// first frame. Reject.
+    /// Behind the sequence with a valid check: stale, replayed or reordered. Reject.
     WrongSequence,
-    /// The CRC does not match. Reject.
-    CrcError,
+    /// The check value does not match at the counter the sequence gives this frame: corrupted,
+    /// forged, or replayed from another session or from 2^16 frames ago. Reject.
+    CheckFailed,
 }
 
 impl E2eStatus {
@@ -91,117 +170,89 @@ impl E2eStatus {
     }
 }
 
-/// Rolling-counter state of one identifier at the receiver.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct E2eChecker {
-    last: Option<u16>,
-    candidate: Option<u16>,
-    max_delta: u16,
+/// How many high halves a receiver tries for the first frame of a sender it has not heard in
+/// this session: it may have joined late, after the sender's counter passed 2^16. A CRC is
+/// cheap to try 256 times (2^24 frames: 4.6 h at 1 kHz); a MAC is tried at high half zero only,
+/// so that a flood of forged first frames costs one CMAC each.
+pub const fn join_tries(check: Check) -> u32 {
+    match check {
+        Check::Crc => 256,
+        Check::Mac => 1,
+    }
 }
 
-/// Default tolerated counter step: up to 9 lost frames in a row still count as in sequence.
-pub const DEFAULT_MAX_DELTA: u16 = 10;
-
-impl Default for E2eChecker {
-    fn default() -> Self {
-        Self::new(DEFAULT_MAX_DELTA)
-    }
+/// Counter state of one identifier at the receiver.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct E2eChecker {
+    last: Option<u32>,
 }
 
 impl E2eChecker {
-    /// A checker that accepts a counter step of 1…`max_delta` (at least 1).
-    pub const fn new(max_delta: u16) -> Self {
-        Self {
-            last: None,
-            candidate: None,
-            max_delta: if max_delta == 0 { 1 } else { max_delta },
-        }
+    /// A checker that has heard nothing.
+    pub const fn new() -> Self {
+        Self { last: None }
     }
 
-    /// Checks a whole message: CRC first, then its counter against the sequence.
-    pub fn check_message(&mut self, data_id: u16, message: &[u8]) -> E2eStatus {
-        match verify(data_id, message) {
-            Some(counter) => self.check_counter(counter),
-            None => E2eStatus::CrcError,
-        }
+    /// Forgets the sequence (a new session starts every sender at zero).
+    pub fn reset(&mut self) {
+        self.last = None;
     }
 
-    /// Checks the counter of a frame whose CRC already matched, and advances the sequence
-    /// when the frame is accepted.
+    /// The last accepted full counter.
+    pub const fn last(&self) -> Option<u32> {
+        self.last
+    }
+
+    /// Places a received low counter in the sequence, verifies the frame at that full counter
+    /// with `verify`, and advances the sequence when the frame is accepted.
     ///
-    /// A frame outside the window is rejected; if the next frame continues from it (its
-    /// counter plus one), the sender is taken to have restarted and the sequence
-    /// resynchronises there ([`E2eStatus::Initial`]).
-    pub fn check_counter(&mut self, counter: u16) -> E2eStatus {
+    /// Ahead by 1…2^15 − 1 is in sequence (the frames between are lost); the same counter is a
+    /// repeat; anything else is behind. Only a frame whose check holds at the counter so placed
+    /// is in sequence, so a replay that lands ahead by wrap-around fails its check.
+    pub fn check(
+        &mut self,
+        low: u16,
+        tries: u32,
+        mut verify: impl FnMut(u32) -> bool,
+    ) -> E2eStatus {
         let Some(last) = self.last else {
-            self.accept(counter);
-            return E2eStatus::Initial;
+            let found = (0..tries)
+                .map(|high| high << 16 | u32::from(low))
+                .find(|full| verify(*full));
+            return match found {
+                Some(full) => {
+                    self.last = Some(full);
+                    E2eStatus::Initial
+                }
+                None => E2eStatus::CheckFailed,
+            };
         };
-        let delta = counter.wrapping_sub(last);
-        let status = if delta == 0 {
-            E2eStatus::Repeated
-        } else if delta == 1 {
-            E2eStatus::Ok
-        } else if delta <= self.max_delta {
-            E2eStatus::OkSomeLost { lost: delta - 1 }
-        } else if self.candidate == Some(counter.wrapping_sub(1)) {
-            E2eStatus::Initial
-        } else {
-            self.candidate = Some(counter);
-            return E2eStatus::WrongSequence;
-        };
-        if status.is_accepted() {
-            self.accept(counter);
+        let delta = low.wrapping_sub((last & 0xFFFF) as u16);
+        if delta == 0 {
+            return if verify(last) {
+                E2eStatus::Repeated
+            } else {
+                E2eStatus::CheckFailed
+            };
         }
-        status
-    }
-
-    /// How many frames a sender skipped if `counter` jumps ahead of the sequence beyond the
-    /// tolerated window (a burst of loss longer than the window): counted from the last
-    /// accepted counter, or from a pending out-of-window one it continues after. `None` for a
-    /// counter in the window (see [`E2eStatus::OkSomeLost`]), a repeat, or one behind (half the
-    /// counter range or more ahead counts as behind: stale, replayed or reordered, not lost).
-    pub fn skipped_ahead(&self, counter: u16) -> Option<u16> {
-        const HALF: u16 = 0x8000;
-        let last = self.last?;
-        let ahead_of_last = |delta: u16| delta > self.max_delta && delta < HALF;
-        if let Some(candidate) = self
-            .candidate
-            .filter(|candidate| candidate.wrapping_sub(last) < HALF)
-        {
-            match counter.wrapping_sub(candidate) {
-                // The pending counter again (a repeat), or the one after it (the sequence
-                // resynchronises there): nothing skipped.
-                0 | 1 => return None,
-                delta if (2..HALF).contains(&delta) => return Some(delta - 1),
-                _ => {}
+        if delta < 0x8000 {
+            let full = last.wrapping_add(u32::from(delta));
+            if !verify(full) {
+                return E2eStatus::CheckFailed;
             }
+            self.last = Some(full);
+            return match delta {
+                1 => E2eStatus::Ok,
+                _ => E2eStatus::OkSomeLost {
+                    lost: u32::from(delta) - 1,
+                },
+            };
         }
-        Some(counter.wrapping_sub(last))
-            .filter(|delta| ahead_of_last(*delta))
-            .map(|delta| delta - 1)
-    }
-
-    fn accept(&mut self, counter: u16) {
-        self.last = Some(counter);
-        self.candidate = None;
-    }
-}
-
-/// The sending side of one identifier: hands out the rolling counter.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct E2eCounter(u16);
-
-impl E2eCounter {
-    /// A counter starting at `first`.
-    pub const fn starting_at(first: u16) -> Self {
-        Self(first)
-    }
-
-    /// The counter for the next frame.
-    pub fn advance(&mut self) -> u16 {
-        let current = self.0;
-        self.0 = self.0.wrapping_add(1);
-        current
+        let behind = 0x1_0000 - u32::from(delta);
+        if verify(last.wrapping_sub(behind)) {
+            E2eStatus::WrongSequence
+        } else {
+            E2eStatus::CheckFailed
+        }
     }
 }

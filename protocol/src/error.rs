@@ -1,6 +1,6 @@
 //! Why a frame was rejected.
 
-use crate::e2e::E2eStatus;
+use crate::e2e::{Check, E2eStatus};
 
 /// A frame that is not acted on, and why. Every variant maps to one [`RejectCause`] so a
 /// receiver can count rejections by cause.
@@ -18,8 +18,39 @@ pub enum DecodeError {
         /// Length received.
         got: usize,
     },
-    /// The E2E CRC does not match: the frame was corrupted or sent on the wrong identifier.
+    /// The E2E CRC does not match at the counter and session the receiver expects: the frame
+    /// was corrupted, sent on the wrong identifier, or replayed from another session or from
+    /// 2^16 frames ago.
     CrcMismatch {
+        /// Identifier of the frame.
+        id: u16,
+    },
+    /// The authentication code (CMAC) does not match: forged without the key, corrupted, or
+    /// replayed from another session or from 2^16 frames ago.
+    Unauthentic {
+        /// Identifier of the frame.
+        id: u16,
+    },
+    /// The frame is bound to a session and this node has not joined one yet (it has not heard
+    /// the controller's announcement).
+    NoSession {
+        /// Identifier of the frame.
+        id: u16,
+    },
+    /// An announcement of an older session than the one this node is in: a replay.
+    StaleSession {
+        /// Identifier of the frame.
+        id: u16,
+    },
+    /// An announcement of another wire version: this node and the announcing controller do
+    /// not speak the same protocol; update one of them.
+    WireVersion {
+        /// The version announced.
+        theirs: u8,
+    },
+    /// A release that does not echo the controller's present release token: made for another
+    /// latch, withheld and sent late, or sent when nothing is latched.
+    StaleRelease {
         /// Identifier of the frame.
         id: u16,
     },
@@ -68,11 +99,18 @@ pub enum RejectCause {
     WrongSequence = 5,
     /// See [`DecodeError::RateLimited`].
     RateLimited = 6,
+    /// See [`DecodeError::Unauthentic`].
+    Unauthentic = 7,
+    /// See [`DecodeError::NoSession`], [`DecodeError::StaleSession`] and
+    /// [`DecodeError::WireVersion`].
+    Session = 8,
+    /// See [`DecodeError::StaleRelease`].
+    StaleRelease = 9,
 }
 
 impl RejectCause {
     /// Every cause, in counter order.
-    pub const ALL: [RejectCause; 7] = [
+    pub const ALL: [RejectCause; 10] = [
         RejectCause::UnknownId,
         RejectCause::WrongLength,
         RejectCause::Crc,
@@ -80,6 +118,9 @@ impl RejectCause {
         RejectCause::Repeated,
         RejectCause::WrongSequence,
         RejectCause::RateLimited,
+        RejectCause::Unauthentic,
+        RejectCause::Session,
+        RejectCause::StaleRelease,
     ];
 
     /// Short name for logs and tables.
@@ -92,6 +133,9 @@ impl RejectCause {
             RejectCause::Repeated => "repeated",
             RejectCause::WrongSequence => "wrong_sequence",
             RejectCause::RateLimited => "rate_limited",
+            RejectCause::Unauthentic => "unauthentic",
+            RejectCause::Session => "session",
+            RejectCause::StaleRelease => "stale_release",
         }
     }
 }
@@ -107,15 +151,24 @@ impl DecodeError {
             DecodeError::Repeated { .. } => RejectCause::Repeated,
             DecodeError::WrongSequence { .. } => RejectCause::WrongSequence,
             DecodeError::RateLimited { .. } => RejectCause::RateLimited,
+            DecodeError::Unauthentic { .. } => RejectCause::Unauthentic,
+            DecodeError::NoSession { .. }
+            | DecodeError::StaleSession { .. }
+            | DecodeError::WireVersion { .. } => RejectCause::Session,
+            DecodeError::StaleRelease { .. } => RejectCause::StaleRelease,
         }
     }
 
-    /// The rejection a rejecting E2E status stands for, or `None` if the status accepts.
-    pub const fn from_e2e(id: u16, status: E2eStatus) -> Option<DecodeError> {
+    /// The rejection a rejecting E2E status stands for on a frame checked with `check`, or
+    /// `None` if the status accepts.
+    pub const fn from_e2e(id: u16, check: Check, status: E2eStatus) -> Option<DecodeError> {
         match status {
             E2eStatus::Repeated => Some(DecodeError::Repeated { id }),
             E2eStatus::WrongSequence => Some(DecodeError::WrongSequence { id }),
-            E2eStatus::CrcError => Some(DecodeError::CrcMismatch { id }),
+            E2eStatus::CheckFailed => Some(match check {
+                Check::Crc => DecodeError::CrcMismatch { id },
+                Check::Mac => DecodeError::Unauthentic { id },
+            }),
             E2eStatus::Ok | E2eStatus::OkSomeLost { .. } | E2eStatus::Initial => None,
         }
     }
@@ -151,6 +204,28 @@ impl core::fmt::Display for DecodeError {
             DecodeError::RateLimited { id } => {
                 write!(f, "CAN id 0x{id:03X}: over the receiver's rate limit")
             }
+            DecodeError::Unauthentic { id } => write!(
+                f,
+                "CAN id 0x{id:03X}: authentication code mismatch (forged, corrupted or replayed)"
+            ),
+            DecodeError::NoSession { id } => write!(
+                f,
+                "CAN id 0x{id:03X}: no session yet (the controller's announcement not heard)"
+            ),
+            DecodeError::StaleSession { id } => write!(
+                f,
+                "CAN id 0x{id:03X}: announcement of an older session (a replay)"
+            ),
+            DecodeError::WireVersion { theirs } => write!(
+                f,
+                "the controller speaks wire version {theirs}, this build speaks {}: run the \
+                 same release of firmware, simulator and teleop",
+                crate::session::WIRE_VERSION
+            ),
+            DecodeError::StaleRelease { id } => write!(
+                f,
+                "CAN id 0x{id:03X}: E-stop release for another latch than the present one"
+            ),
         }
     }
 }

@@ -20,6 +20,8 @@ pub enum MessageId {
     EStop,
     /// Lockstep tick from the simulator.
     Sync,
+    /// The controller's session announcement: wire version and boot epoch.
+    Announce,
     /// Position targets for all 16 leg joints.
     LegTargets,
     /// Torque command for both wheels.
@@ -44,9 +46,10 @@ pub enum MessageId {
 
 impl MessageId {
     /// Every identifier on the bus, in priority order (highest first).
-    pub const ALL: [MessageId; 19] = [
+    pub const ALL: [MessageId; 20] = [
         MessageId::EStop,
         MessageId::Sync,
+        MessageId::Announce,
         MessageId::LegTargets,
         MessageId::WheelCommand,
         MessageId::LegFeedback(Leg::Fl),
@@ -71,6 +74,7 @@ impl MessageId {
         match self {
             MessageId::EStop => 0x000,
             MessageId::Sync => 0x010,
+            MessageId::Announce => 0x020,
             MessageId::LegTargets => 0x100,
             MessageId::WheelCommand => 0x101,
             MessageId::LegFeedback(leg) => 0x180 + leg as u16,
@@ -89,6 +93,7 @@ impl MessageId {
         Some(match raw {
             0x000 => MessageId::EStop,
             0x010 => MessageId::Sync,
+            0x020 => MessageId::Announce,
             0x100 => MessageId::LegTargets,
             0x101 => MessageId::WheelCommand,
             0x180 => MessageId::LegFeedback(Leg::Fl),
@@ -115,16 +120,17 @@ impl MessageId {
         match self {
             MessageId::EStop => 0,
             MessageId::Sync => 1,
-            MessageId::LegTargets => 2,
-            MessageId::WheelCommand => 3,
-            MessageId::LegFeedback(leg) => 4 + leg as usize,
-            MessageId::WheelFeedback => 8,
-            MessageId::Imu => 9,
-            MessageId::TeleopCommand => 10,
-            MessageId::TeleopHeartbeat => 11,
-            MessageId::ControllerStatus => 12,
-            MessageId::DriveStatus(drive) => 13 + drive as usize,
-            MessageId::RejectCounters => 18,
+            MessageId::Announce => 2,
+            MessageId::LegTargets => 3,
+            MessageId::WheelCommand => 4,
+            MessageId::LegFeedback(leg) => 5 + leg as usize,
+            MessageId::WheelFeedback => 9,
+            MessageId::Imu => 10,
+            MessageId::TeleopCommand => 11,
+            MessageId::TeleopHeartbeat => 12,
+            MessageId::ControllerStatus => 13,
+            MessageId::DriveStatus(drive) => 14 + drive as usize,
+            MessageId::RejectCounters => 19,
         }
     }
 

@@ -1,15 +1,19 @@
 //! Any message of the bus, decoded from a raw identifier and data.
 
 use crate::codec::{decode, encode, EncodeError, Message};
+use crate::e2e::{Protection, HEADER_LEN};
 use crate::error::DecodeError;
 use crate::frame::Frame;
 use crate::id::MessageId;
 use crate::msg::{
-    ControllerStatus, DriveStatus, EStop, Imu, LegFeedback, LegTargets, RejectCounters, Sync,
-    TeleopCommand, TeleopHeartbeat, WheelCommand, WheelFeedback,
+    Announce, ControllerStatus, DriveStatus, EStop, Imu, LegFeedback, LegTargets, RejectCounters,
+    Sync, TeleopCommand, TeleopHeartbeat, WheelCommand, WheelFeedback,
 };
+use crate::msg::{CLASSIC_LATCH_LEN, LATCH_CHECKED_LEN};
 use crate::node::{Drive, Leg};
+use crate::session::Session;
 use crate::signal::Field;
+use crate::units::EStopAction;
 
 /// A decoded message with the node it concerns, where the identifier names one.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -17,6 +21,7 @@ use crate::signal::Field;
 pub enum AnyMessage {
     EStop(EStop),
     Sync(Sync),
+    Announce(Announce),
     LegTargets(LegTargets),
     WheelCommand(WheelCommand),
     LegFeedback(Leg, LegFeedback),
@@ -29,25 +34,33 @@ pub enum AnyMessage {
     RejectCounters(RejectCounters),
 }
 
-/// A frame that passed the stateless checks (id, length, CRC, ranges).
+/// A frame that passed the stateless checks (id, length, ranges); its check value is not
+/// verified yet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Decoded {
     /// Which identifier it came on.
     pub id: MessageId,
-    /// Its rolling counter, for the sequence check.
+    /// The low half of its rolling counter, for the sequence check.
     pub counter: u16,
     /// The message.
     pub message: AnyMessage,
 }
 
-/// Decodes a frame's identifier and data without sequence state: unknown id, wrong length,
-/// CRC mismatch and out-of-range values are rejected here. Use
-/// [`Receiver`](crate::Receiver) to also reject repeated and out-of-sequence frames.
+/// Parses a frame's identifier and data without session or sequence state: unknown id, wrong
+/// length and out-of-range values are rejected here. The check value is not verified: use
+/// [`Receiver`](crate::Receiver) for that and to reject repeated, stale and forged frames.
+///
+/// An E-stop latch sent as a classic CAN frame ([`CLASSIC_LATCH_LEN`] bytes) is read as the
+/// latch it is; any other classic E-stop is refused as the wrong length.
 pub fn decode_frame(raw_id: u16, data: &[u8]) -> Result<Decoded, DecodeError> {
     let id = MessageId::from_raw(raw_id).ok_or(DecodeError::UnknownId(raw_id))?;
+    if id == MessageId::EStop && data.len() == CLASSIC_LATCH_LEN {
+        return decode_classic_latch(data);
+    }
     let (message, counter) = match id {
         MessageId::EStop => decode(id, data).map(|(m, c)| (AnyMessage::EStop(m), c))?,
         MessageId::Sync => decode(id, data).map(|(m, c)| (AnyMessage::Sync(m), c))?,
+        MessageId::Announce => decode(id, data).map(|(m, c)| (AnyMessage::Announce(m), c))?,
         MessageId::LegTargets => decode(id, data).map(|(m, c)| (AnyMessage::LegTargets(m), c))?,
         MessageId::WheelCommand => {
             decode(id, data).map(|(m, c)| (AnyMessage::WheelCommand(m), c))?
@@ -82,12 +95,50 @@ pub fn decode_frame(raw_id: u16, data: &[u8]) -> Result<Decoded, DecodeError> {
     })
 }
 
+fn decode_classic_latch(data: &[u8]) -> Result<Decoded, DecodeError> {
+    let id = MessageId::EStop;
+    let mut padded = [0_u8; EStop::WIRE_LEN];
+    padded
+        .get_mut(..data.len())
+        .ok_or(DecodeError::WrongLength {
+            id: id.raw(),
+            expected: EStop::WIRE_LEN,
+            got: data.len(),
+        })?
+        .copy_from_slice(data);
+    let (message, counter) = decode::<EStop>(id, &padded)?;
+    if message.action != EStopAction::Latch {
+        return Err(DecodeError::WrongLength {
+            id: id.raw(),
+            expected: EStop::WIRE_LEN,
+            got: data.len(),
+        });
+    }
+    Ok(Decoded {
+        id,
+        counter,
+        message: AnyMessage::EStop(message),
+    })
+}
+
+/// How a frame on `id` with data `data` is protected, and how many payload bytes its check
+/// covers. Read from the raw bytes, before the payload is parsed, so that the check is
+/// verified first: an E-stop whose action byte says latch is checked as a latch.
+pub fn protection_of(id: MessageId, data: &[u8]) -> (Protection, usize) {
+    let layout = id.layout();
+    if id == MessageId::EStop && data.get(HEADER_LEN) == Some(&EStopAction::Latch.raw()) {
+        return (crate::msg::LATCH_PROTECTION, LATCH_CHECKED_LEN);
+    }
+    (layout.protection, layout.len - HEADER_LEN)
+}
+
 impl AnyMessage {
     /// The identifier this message goes out on.
     pub fn id(&self) -> MessageId {
         match self {
             AnyMessage::EStop(_) => MessageId::EStop,
             AnyMessage::Sync(_) => MessageId::Sync,
+            AnyMessage::Announce(_) => MessageId::Announce,
             AnyMessage::LegTargets(_) => MessageId::LegTargets,
             AnyMessage::WheelCommand(_) => MessageId::WheelCommand,
             AnyMessage::LegFeedback(leg, _) => MessageId::LegFeedback(*leg),
@@ -101,21 +152,22 @@ impl AnyMessage {
         }
     }
 
-    /// Encodes this message with rolling counter `counter`.
-    pub fn encode(&self, counter: u16) -> Result<Frame, EncodeError> {
+    /// Encodes this message with the sender's full counter `counter` under `session`.
+    pub fn encode(&self, session: &Session, counter: u32) -> Result<Frame, EncodeError> {
         match self {
-            AnyMessage::EStop(m) => encode(m, (), counter),
-            AnyMessage::Sync(m) => encode(m, (), counter),
-            AnyMessage::LegTargets(m) => encode(m, (), counter),
-            AnyMessage::WheelCommand(m) => encode(m, (), counter),
-            AnyMessage::LegFeedback(leg, m) => encode(m, *leg, counter),
-            AnyMessage::WheelFeedback(m) => encode(m, (), counter),
-            AnyMessage::Imu(m) => encode(m, (), counter),
-            AnyMessage::TeleopCommand(m) => encode(m, (), counter),
-            AnyMessage::TeleopHeartbeat(m) => encode(m, (), counter),
-            AnyMessage::ControllerStatus(m) => encode(m, (), counter),
-            AnyMessage::DriveStatus(drive, m) => encode(m, *drive, counter),
-            AnyMessage::RejectCounters(m) => encode(m, (), counter),
+            AnyMessage::EStop(m) => encode(m, (), session, counter),
+            AnyMessage::Sync(m) => encode(m, (), session, counter),
+            AnyMessage::Announce(m) => encode(m, (), session, counter),
+            AnyMessage::LegTargets(m) => encode(m, (), session, counter),
+            AnyMessage::WheelCommand(m) => encode(m, (), session, counter),
+            AnyMessage::LegFeedback(leg, m) => encode(m, *leg, session, counter),
+            AnyMessage::WheelFeedback(m) => encode(m, (), session, counter),
+            AnyMessage::Imu(m) => encode(m, (), session, counter),
+            AnyMessage::TeleopCommand(m) => encode(m, (), session, counter),
+            AnyMessage::TeleopHeartbeat(m) => encode(m, (), session, counter),
+            AnyMessage::ControllerStatus(m) => encode(m, (), session, counter),
+            AnyMessage::DriveStatus(drive, m) => encode(m, *drive, session, counter),
+            AnyMessage::RejectCounters(m) => encode(m, (), session, counter),
         }
     }
 }
@@ -133,6 +185,9 @@ pub struct Layout {
     pub len: usize,
     /// CAN FD data length on the wire.
     pub wire_len: usize,
+    /// How frames on this identifier are protected (an E-stop latch differs: see
+    /// [`protection_of`]).
+    pub protection: Protection,
 }
 
 const fn layout<M: Message>(name: &'static str) -> Layout {
@@ -142,6 +197,7 @@ const fn layout<M: Message>(name: &'static str) -> Layout {
         fields: M::FIELDS,
         len: M::LEN,
         wire_len: M::WIRE_LEN,
+        protection: M::PROTECTION,
     }
 }
 
@@ -151,6 +207,7 @@ impl MessageId {
         match self {
             MessageId::EStop => layout::<EStop>(EStop::NAME),
             MessageId::Sync => layout::<Sync>(Sync::NAME),
+            MessageId::Announce => layout::<Announce>(Announce::NAME),
             MessageId::LegTargets => layout::<LegTargets>(LegTargets::NAME),
             MessageId::WheelCommand => layout::<WheelCommand>(WheelCommand::NAME),
             MessageId::LegFeedback(leg) => layout::<LegFeedback>(match leg {
@@ -183,6 +240,7 @@ impl MessageId {
                 NodeId::Teleop
             }
             MessageId::Sync => NodeId::Simulator,
+            MessageId::Announce => NodeId::Controller,
             MessageId::LegTargets
             | MessageId::WheelCommand
             | MessageId::ControllerStatus

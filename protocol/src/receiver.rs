@@ -1,52 +1,68 @@
-//! The receiving side of the bus: decode, sequence-check and count every rejection.
+//! The receiving side of the bus: verify, sequence-check, decode and count every rejection.
 
-use crate::e2e::{E2eChecker, E2eStatus};
+use crate::e2e::{self, join_tries, E2eChecker, E2eStatus, Freshness, HEADER_LEN};
 use crate::error::{DecodeError, RejectCause};
 use crate::id::MessageId;
-use crate::message::{decode_frame, AnyMessage};
-use crate::msg::{EStop, RejectCounters};
-use crate::units::EStopAction;
+use crate::message::{decode_frame, protection_of, AnyMessage};
+use crate::msg::{Announce, RejectCounters, CLASSIC_LATCH_LEN};
+use crate::session::{Key, Session};
+use crate::units::{Count, Epoch, WireVersion};
 
 /// A frame the receiver accepted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Accepted {
     /// The message.
     pub message: AnyMessage,
-    /// Its E2E status: `Ok`, `OkSomeLost` or `Initial`; for an E-stop latch also `Repeated` or
-    /// `WrongSequence` (see [`Receiver`]: a latch acts whatever its counter).
+    /// Its E2E status: `Ok`, `OkSomeLost` or `Initial` (an E-stop latch and an announcement,
+    /// which take no part in a sequence, are `Initial`).
     pub status: E2eStatus,
 }
 
-/// Decodes frames, checks each identifier's rolling counter, and counts every rejection by
-/// cause. Nothing rejected reaches the caller as a message.
+/// Verifies frames against the session (see [`crate::session`]), checks each identifier's
+/// counter sequence, decodes, and counts every rejection by cause. Nothing rejected reaches the
+/// caller as a message.
 ///
-/// One exception is deliberate: an E-stop **latch** with a valid CRC is accepted whatever its
-/// counter (its status still says `Repeated` or `WrongSequence`), because acting on a stale or
-/// repeated latch can only stop the robot, while dropping a genuine one — say from an
-/// operator's `cansend` that cannot know the counter — could hurt someone. An E-stop **clear**
-/// passes every check.
+/// The controller's receiver **owns** the session; every other node's receiver is a
+/// **member** that joins on the controller's announcement, moves to a newer one, and refuses an
+/// older one. An E-stop **latch** with a valid CRC is accepted at any time, in any session or
+/// none, whatever its counter: acting on a stale or repeated latch can only stop the robot,
+/// while dropping a genuine one could hurt someone.
 #[derive(Debug, Clone)]
 pub struct Receiver {
+    session: Session,
+    owner: bool,
+    announce_last: Option<u16>,
     checkers: [E2eChecker; MessageId::ALL.len()],
     counters: RejectCounters,
 }
 
-impl Default for Receiver {
-    fn default() -> Self {
-        Self::new(crate::e2e::DEFAULT_MAX_DELTA)
-    }
-}
-
 impl Receiver {
-    /// A receiver that accepts counter steps of 1…`max_delta` on every identifier.
-    pub const fn new(max_delta: u16) -> Self {
+    /// The controller's receiver: `session` is its own.
+    pub const fn owner(session: Session) -> Self {
+        Self::new(session, true)
+    }
+
+    /// Any other node's receiver: it joins the session the controller announces.
+    pub const fn member(key: Key) -> Self {
+        Self::new(Session::unjoined(key), false)
+    }
+
+    const fn new(session: Session, owner: bool) -> Self {
         Self {
-            checkers: [E2eChecker::new(max_delta); MessageId::ALL.len()],
+            session,
+            owner,
+            announce_last: None,
+            checkers: [E2eChecker::new(); MessageId::ALL.len()],
             counters: RejectCounters {
-                rejected: [crate::units::Count::ZERO; RejectCause::ALL.len()],
-                lost: crate::units::Count::ZERO,
+                rejected: [Count::ZERO; RejectCause::ALL.len()],
+                lost: Count::ZERO,
             },
         }
+    }
+
+    /// The session this node is in (or not yet): what its own frames are sealed under.
+    pub const fn session(&self) -> &Session {
+        &self.session
     }
 
     /// Accepts or rejects one frame. A rejection is counted before it is returned.
@@ -64,42 +80,113 @@ impl Receiver {
     }
 
     /// Counts the refusal of a frame this receiver accepted but its caller will not act on
-    /// (say [`DecodeError::RateLimited`]: a flood of valid frames), so that every frame not
-    /// acted on is counted by cause. The frame's sequence step stands: the sender's next frame
-    /// is still in sequence.
+    /// (say [`DecodeError::RateLimited`]: a flood of valid frames, or
+    /// [`DecodeError::StaleRelease`]), so that every frame not acted on is counted by cause.
+    /// The frame's sequence step stands: the sender's next frame is still in sequence.
     pub fn refuse(&mut self, error: DecodeError) {
         self.counters.record(error.cause());
     }
 
     fn check(&mut self, raw_id: u16, data: &[u8]) -> Result<Accepted, DecodeError> {
-        let decoded = decode_frame(raw_id, data)?;
-        let checker = self
-            .checkers
-            .get_mut(decoded.id.index())
-            .ok_or(DecodeError::UnknownId(raw_id))?;
-        let skipped = checker.skipped_ahead(decoded.counter);
-        let status = checker.check_counter(decoded.counter);
-        if status == E2eStatus::WrongSequence {
-            // A burst of loss longer than the window: the frames are lost all the same, and
-            // the link's loss must count them (the frame itself is refused until the
-            // sequence resynchronises on the next one).
-            if let Some(lost) = skipped {
-                self.counters.record_lost(lost);
+        let id = MessageId::from_raw(raw_id).ok_or(DecodeError::UnknownId(raw_id))?;
+        let layout = id.layout();
+        let classic_latch = id == MessageId::EStop && data.len() == CLASSIC_LATCH_LEN;
+        if data.len() != layout.wire_len && !classic_latch {
+            return Err(DecodeError::WrongLength {
+                id: raw_id,
+                expected: layout.wire_len,
+                got: data.len(),
+            });
+        }
+        let (protection, covered) = protection_of(id, data);
+        let epoch = match (protection.bound, self.session.epoch()) {
+            (true, None) => return Err(DecodeError::NoSession { id: raw_id }),
+            (true, Some(epoch)) => Some(epoch),
+            (false, _) => None,
+        };
+        let wrong_length = DecodeError::WrongLength {
+            id: raw_id,
+            expected: layout.wire_len,
+            got: data.len(),
+        };
+        let (sent, low) = e2e::header(data).ok_or(wrong_length)?;
+        let payload = data
+            .get(HEADER_LEN..HEADER_LEN + covered)
+            .ok_or(wrong_length)?;
+        let key = *self.session.key();
+        let verify = |counter: u32| {
+            let freshness = Freshness {
+                data_id: id.data_id(),
+                epoch,
+                counter,
+            };
+            e2e::check_value(protection.check, &key, &freshness, payload) == sent
+        };
+        let status = if protection.sequenced {
+            let checker = self
+                .checkers
+                .get_mut(id.index())
+                .ok_or(DecodeError::UnknownId(raw_id))?;
+            checker.check(low, join_tries(protection.check), verify)
+        } else if verify(u32::from(low)) {
+            E2eStatus::Initial
+        } else {
+            E2eStatus::CheckFailed
+        };
+        if let Some(error) = DecodeError::from_e2e(raw_id, protection.check, status) {
+            return Err(error);
+        }
+        let message = decode_frame(raw_id, data)?.message;
+        if let AnyMessage::Announce(announce) = message {
+            self.on_announce(raw_id, low, &announce)?;
+        }
+        Ok(Accepted { message, status })
+    }
+
+    /// Joins, moves to, or refuses the session an authentic announcement opens.
+    fn on_announce(
+        &mut self,
+        raw_id: u16,
+        low: u16,
+        announce: &Announce,
+    ) -> Result<(), DecodeError> {
+        if announce.version != WireVersion::THIS {
+            return Err(DecodeError::WireVersion {
+                theirs: announce.version.raw(),
+            });
+        }
+        let joined = self.session.epoch();
+        match joined {
+            Some(epoch) if announce.epoch < epoch => Err(DecodeError::StaleSession { id: raw_id }),
+            Some(epoch) if announce.epoch == epoch => {
+                if self.owner {
+                    return Ok(());
+                }
+                let delta = self.announce_last.map(|last| low.wrapping_sub(last));
+                match delta {
+                    Some(0) => Err(DecodeError::Repeated { id: raw_id }),
+                    Some(delta) if delta >= 0x8000 => {
+                        Err(DecodeError::WrongSequence { id: raw_id })
+                    }
+                    _ => {
+                        self.announce_last = Some(low);
+                        Ok(())
+                    }
+                }
+            }
+            _ if self.owner => Err(DecodeError::StaleSession { id: raw_id }),
+            _ => {
+                self.join(announce.epoch, low);
+                Ok(())
             }
         }
-        let fail_safe = matches!(
-            decoded.message,
-            AnyMessage::EStop(EStop {
-                action: EStopAction::Latch,
-                ..
-            })
-        );
-        match DecodeError::from_e2e(raw_id, status) {
-            Some(error) if !fail_safe => Err(error),
-            _ => Ok(Accepted {
-                message: decoded.message,
-                status,
-            }),
+    }
+
+    fn join(&mut self, epoch: Epoch, announce_low: u16) {
+        self.session.join(epoch);
+        self.announce_last = Some(announce_low);
+        for checker in &mut self.checkers {
+            checker.reset();
         }
     }
 

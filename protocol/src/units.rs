@@ -58,6 +58,20 @@ wire_scalar!(
     Millis(u32) = U32, exp10 0, unit "ms", raw 0, u32::MAX
 );
 wire_scalar!(
+    /// A controller boot ([`crate::session`]): strictly greater at every start. 1, `u32`.
+    Epoch(u32) = U32, exp10 0, unit "", raw 0, u32::MAX
+);
+wire_scalar!(
+    /// Version of the wire contract ([`crate::session::WIRE_VERSION`]). 1, `u8`.
+    WireVersion(u8) = U8, exp10 0, unit "", raw 0, u8::MAX
+);
+wire_scalar!(
+    /// E-stop release token: which latch a release answers. The controller counts the times
+    /// it entered its E-stop in this session and publishes the count; a release must echo it.
+    /// 1, `u16`, wraps.
+    ReleaseToken(u16) = U16, exp10 0, unit "", raw 0, u16::MAX
+);
+wire_scalar!(
     /// Event counter. 1 event, `u16`, wraps.
     Count(u16) = U16, exp10 0, unit "", raw 0, u16::MAX
 );
@@ -68,6 +82,38 @@ impl Count {
 
     /// Count one more event, wrapping at `u16::MAX`.
     pub const fn increment(self) -> Self {
+        Self(self.0.wrapping_add(1))
+    }
+}
+
+impl Epoch {
+    /// The epoch numbered `raw` (every `u32` is one).
+    pub const fn new(raw: u32) -> Self {
+        Self(raw)
+    }
+
+    /// The next epoch, or `None` after the last.
+    pub const fn next(self) -> Option<Self> {
+        match self.0.checked_add(1) {
+            Some(raw) => Some(Self(raw)),
+            None => None,
+        }
+    }
+}
+
+impl WireVersion {
+    /// The version this build speaks.
+    pub const THIS: WireVersion = WireVersion(crate::session::WIRE_VERSION);
+}
+
+impl ReleaseToken {
+    /// The token numbered `raw`.
+    pub const fn new(raw: u16) -> Self {
+        Self(raw)
+    }
+
+    /// The token after this one, wrapping.
+    pub const fn next(self) -> Self {
         Self(self.0.wrapping_add(1))
     }
 }
@@ -169,6 +215,10 @@ wire_flags!(
         /// The bus loses too many of the controller's inbound frames: motion stops and new
         /// motion requests are refused until the link recovers.
         LINK_DEGRADED = 8 => "link_degraded",
+        /// Motion is interlocked (no unexpected start-up): after the controller started, an
+        /// E-stop release, or a lost operator, nothing moves until the operator sends STOP
+        /// (X) and then a motion.
+        AWAITING_STOP = 9 => "awaiting_stop",
     }
 );
 

@@ -1,199 +1,398 @@
-//! Every status of the E2E receiver.
+//! Every status of the E2E receiver, the check values against their references, and the wire
+//! layout of the header.
 
-use protocol::e2e::{crc, protect, verify, HEADER_LEN};
-use protocol::{E2eChecker, E2eCounter, E2eStatus};
+use proptest::prelude::*;
+use protocol::e2e::{check_value, header, join_tries, protect, Freshness, HEADER_LEN};
+use protocol::{
+    AnyMessage, Check, E2eChecker, E2eStatus, Epoch, Key, Receiver, Session, Sync, Tick, TEST_KEY,
+};
 
-fn checker_after(counters: &[u16]) -> E2eChecker {
-    let mut checker = E2eChecker::new(3);
+/// Offers `checker` a frame of a genuine sender whose full counter is `sent`: its check value
+/// holds at that counter and at no other, as a check that covers the full counter does.
+fn offer(checker: &mut E2eChecker, sent: u32) -> E2eStatus {
+    checker.check(sent as u16, 1, |full| full == sent)
+}
+
+/// Offers `checker` a frame whose check holds at no counter: corrupted, forged, or from
+/// another session.
+fn offer_forged(checker: &mut E2eChecker, low: u16) -> E2eStatus {
+    checker.check(low, 256, |_| false)
+}
+
+fn checker_after(counters: &[u32]) -> E2eChecker {
+    let mut checker = E2eChecker::new();
     for &c in counters {
-        assert!(checker.check_counter(c).is_accepted(), "setup counter {c}");
+        let tries = (c >> 16) + 1;
+        assert!(
+            checker
+                .check(c as u16, tries, |full| full == c)
+                .is_accepted(),
+            "setup counter {c}"
+        );
     }
     checker
 }
 
 #[test]
 fn first_frame_is_initial_then_ok() {
-    let mut checker = E2eChecker::new(3);
-    assert_eq!(checker.check_counter(40), E2eStatus::Initial);
-    assert_eq!(checker.check_counter(41), E2eStatus::Ok);
+    let mut checker = E2eChecker::new();
+    assert_eq!(checker.last(), None);
+    assert_eq!(offer(&mut checker, 40), E2eStatus::Initial);
+    assert_eq!(offer(&mut checker, 41), E2eStatus::Ok);
+    assert_eq!(checker.last(), Some(41));
 }
 
 #[test]
-fn a_gap_within_the_window_is_ok_some_lost() {
+fn a_gap_is_ok_some_lost() {
     let mut checker = checker_after(&[10]);
-    assert_eq!(checker.check_counter(13), E2eStatus::OkSomeLost { lost: 2 });
-    assert_eq!(checker.check_counter(14), E2eStatus::Ok);
+    assert_eq!(offer(&mut checker, 13), E2eStatus::OkSomeLost { lost: 2 });
+    assert_eq!(offer(&mut checker, 14), E2eStatus::Ok);
+    // No window short of half the counter range: a longer burst is accepted and counted too.
+    assert_eq!(offer(&mut checker, 30), E2eStatus::OkSomeLost { lost: 15 });
+    assert_eq!(checker.last(), Some(30));
 }
 
 #[test]
 fn the_same_counter_twice_is_repeated() {
     let mut checker = checker_after(&[10]);
-    assert_eq!(checker.check_counter(10), E2eStatus::Repeated);
+    assert_eq!(offer(&mut checker, 10), E2eStatus::Repeated);
     assert_eq!(
-        checker.check_counter(11),
+        offer(&mut checker, 11),
         E2eStatus::Ok,
         "a repeat does not disturb the sequence"
     );
 }
 
 #[test]
-fn a_jump_beyond_the_window_or_backwards_is_wrong_sequence() {
+fn a_step_backwards_is_wrong_sequence() {
     let mut checker = checker_after(&[10]);
-    assert_eq!(checker.check_counter(14), E2eStatus::WrongSequence);
-    assert_eq!(checker.check_counter(9), E2eStatus::WrongSequence);
+    assert_eq!(offer(&mut checker, 9), E2eStatus::WrongSequence);
+    assert_eq!(offer(&mut checker, 0), E2eStatus::WrongSequence);
     assert_eq!(
-        checker.check_counter(11),
+        offer(&mut checker, 11),
         E2eStatus::Ok,
         "rejected frames do not move the sequence"
     );
 }
 
+/// Wire version 1 resynchronised on two consecutive frames, which let a replay of two
+/// recorded frames take over the sequence. Now only a new session restarts it.
 #[test]
-fn a_restarted_sender_is_resynchronised_after_two_consecutive_frames() {
+fn a_sender_restarted_within_the_session_is_not_resynchronised() {
     let mut checker = checker_after(&[5000, 5001]);
-    assert_eq!(checker.check_counter(0), E2eStatus::WrongSequence);
-    assert_eq!(checker.check_counter(1), E2eStatus::Initial);
-    assert_eq!(checker.check_counter(2), E2eStatus::Ok);
+    for restarted in 0..100 {
+        assert_eq!(
+            offer(&mut checker, restarted),
+            E2eStatus::WrongSequence,
+            "frame {restarted} of the restarted sender"
+        );
+    }
+    assert_eq!(checker.last(), Some(5001));
+    // A new session: the receiver forgets the sequence and the sender starts at zero.
+    checker.reset();
+    assert_eq!(offer(&mut checker, 0), E2eStatus::Initial);
+    assert_eq!(offer(&mut checker, 1), E2eStatus::Ok);
 }
 
 #[test]
-fn a_single_replayed_frame_does_not_resynchronise() {
+fn a_single_replayed_frame_does_not_disturb_the_sequence() {
     let mut checker = checker_after(&[5000]);
-    assert_eq!(checker.check_counter(100), E2eStatus::WrongSequence);
-    assert_eq!(checker.check_counter(5001), E2eStatus::Ok);
+    assert_eq!(offer(&mut checker, 100), E2eStatus::WrongSequence);
+    assert_eq!(offer(&mut checker, 5001), E2eStatus::Ok);
+    assert_eq!(offer(&mut checker, 101), E2eStatus::WrongSequence);
+    assert_eq!(offer(&mut checker, 5002), E2eStatus::Ok);
+}
+
+#[test]
+fn the_counter_wraps_into_the_high_half() {
+    let mut checker = checker_after(&[0xFFFE, 0xFFFF]);
+    assert_eq!(offer(&mut checker, 0x1_0000), E2eStatus::Ok);
+    assert_eq!(checker.last(), Some(0x1_0000));
+    // The frame of full counter 0 has the same low half as the one just accepted, but its
+    // check holds only at 0: a replay from 2^16 frames ago fails its check.
+    assert_eq!(offer(&mut checker, 0), E2eStatus::CheckFailed);
+    assert_eq!(offer(&mut checker, 0x1_0001), E2eStatus::Ok);
+    assert_eq!(offer(&mut checker, 1), E2eStatus::CheckFailed);
+    assert_eq!(offer(&mut checker, 0xFFFF), E2eStatus::WrongSequence);
+    assert_eq!(checker.last(), Some(0x1_0001));
+}
+
+#[test]
+fn a_first_frame_is_looked_for_in_as_many_high_halves_as_allowed() {
+    let sent = 3 << 16 | 7;
+    let mut checker = E2eChecker::new();
     assert_eq!(
-        checker.check_counter(101),
-        E2eStatus::WrongSequence,
-        "the replay candidate was dropped"
+        checker.check(7, 3, |full| full == sent),
+        E2eStatus::CheckFailed
+    );
+    assert_eq!(checker.last(), None);
+    assert_eq!(checker.check(7, 4, |full| full == sent), E2eStatus::Initial);
+    assert_eq!(checker.last(), Some(sent));
+    assert_eq!(join_tries(Check::Crc), 256);
+    assert_eq!(
+        join_tries(Check::Mac),
+        1,
+        "a forged first frame costs one CMAC"
     );
 }
 
 #[test]
-fn the_counter_wraps() {
-    let mut checker = checker_after(&[u16::MAX - 1, u16::MAX]);
-    assert_eq!(checker.check_counter(0), E2eStatus::Ok);
-    let mut counter = E2eCounter::starting_at(u16::MAX);
-    assert_eq!((counter.advance(), counter.advance()), (u16::MAX, 0));
+fn half_the_counter_range_ahead_is_behind() {
+    let mut checker = checker_after(&[10]);
+    assert_eq!(
+        offer(&mut checker, 10 + 0x7FFF),
+        E2eStatus::OkSomeLost { lost: 0x7FFE }
+    );
+    // 2^15 ahead reads as 2^15 behind, where the check does not hold.
+    let mut checker = checker_after(&[10]);
+    assert_eq!(offer(&mut checker, 10 + 0x8000), E2eStatus::CheckFailed);
+    assert_eq!(checker.last(), Some(10));
+    // A genuine frame 2^15 behind is stale; one 2^15 + 1 behind reads as ahead and fails.
+    let mut checker = checker_after(&[0x9000]);
+    assert_eq!(offer(&mut checker, 0x1000), E2eStatus::WrongSequence);
+    assert_eq!(offer(&mut checker, 0x0FFF), E2eStatus::CheckFailed);
 }
 
 #[test]
-fn a_corrupted_message_is_crc_error_and_leaves_the_sequence_alone() {
+fn a_frame_whose_check_fails_is_check_failed_and_leaves_the_sequence_alone() {
+    let mut checker = E2eChecker::new();
+    assert_eq!(offer_forged(&mut checker, 0), E2eStatus::CheckFailed);
+    assert_eq!(checker.last(), None);
+    let mut checker = checker_after(&[10]);
+    for low in [9, 10, 11, 5000, 0x8000 + 10] {
+        assert_eq!(
+            offer_forged(&mut checker, low),
+            E2eStatus::CheckFailed,
+            "{low}"
+        );
+    }
+    assert_eq!(offer(&mut checker, 11), E2eStatus::Ok);
+}
+
+/// A message with `payload` protected under `freshness`.
+fn protected(check: Check, key: &Key, freshness: &Freshness, payload: &[u8]) -> Vec<u8> {
+    let mut message = vec![0; HEADER_LEN];
+    message.extend_from_slice(payload);
+    protect(check, key, freshness, &mut message).unwrap();
+    message
+}
+
+/// The receiver's view of `message` on `data_id` in `epoch`: its check value verified at the
+/// full counter the checker proposes.
+fn receive_bytes(
+    checker: &mut E2eChecker,
+    check: Check,
+    key: &Key,
+    data_id: u16,
+    epoch: Option<Epoch>,
+    message: &[u8],
+) -> E2eStatus {
+    let (sent, low) = header(message).unwrap();
+    checker.check(low, join_tries(check), |counter| {
+        let freshness = Freshness {
+            data_id,
+            epoch,
+            counter,
+        };
+        check_value(check, key, &freshness, &message[HEADER_LEN..]) == sent
+    })
+}
+
+#[test]
+fn a_corrupted_message_fails_its_check_and_leaves_the_sequence_alone() {
+    let epoch = Some(Epoch::new(9));
     let data_id = 0xC123;
-    let mut message = [0_u8; HEADER_LEN + 6];
-    message[HEADER_LEN..].copy_from_slice(b"robot!");
-    protect(data_id, 7, &mut message);
-    assert_eq!(verify(data_id, &message), Some(7));
+    for check in [Check::Crc, Check::Mac] {
+        let freshness = Freshness {
+            data_id,
+            epoch,
+            counter: 7,
+        };
+        let message = protected(check, &TEST_KEY, &freshness, b"robot!");
+        assert_eq!(header(&message).map(|(_, low)| low), Some(7));
 
-    let mut checker = E2eChecker::default();
-    let mut corrupted = message;
-    corrupted[HEADER_LEN + 2] ^= 0x10;
+        let mut checker = E2eChecker::default();
+        let mut corrupted = message.clone();
+        corrupted[HEADER_LEN + 2] ^= 0x10;
+        let mut rx = |message: &[u8], data_id: u16, epoch: Option<Epoch>| {
+            receive_bytes(&mut checker, check, &TEST_KEY, data_id, epoch, message)
+        };
+        assert_eq!(rx(&corrupted, data_id, epoch), E2eStatus::CheckFailed);
+        assert_eq!(
+            rx(&message, data_id ^ 1, epoch),
+            E2eStatus::CheckFailed,
+            "{check:?}: wrong data id"
+        );
+        assert_eq!(
+            rx(&message, data_id, Some(Epoch::new(10))),
+            E2eStatus::CheckFailed,
+            "{check:?}: another session"
+        );
+        assert_eq!(
+            rx(&message, data_id, None),
+            E2eStatus::CheckFailed,
+            "{check:?}: no session"
+        );
+        assert_eq!(rx(&message, data_id, epoch), E2eStatus::Initial);
+        assert_eq!(rx(&message, data_id, epoch), E2eStatus::Repeated);
+    }
+}
+
+#[test]
+fn the_crc_is_crc32c_over_data_id_epoch_counter_then_payload() {
+    // CRC-32C (Castagnoli) check value: "123456789" → 0xE3069283.
+    let reference = crc::Crc::<u32>::new(&crc::CRC_32_ISCSI);
+    assert_eq!(reference.checksum(b"123456789"), 0xE306_9283);
+    let freshness = Freshness {
+        data_id: 0x3412,
+        epoch: Some(Epoch::new(0x0A0B_0C0D)),
+        counter: 0x0102_0304,
+    };
+    let mut covered = vec![0x12, 0x34, 0x0D, 0x0C, 0x0B, 0x0A, 0x04, 0x03, 0x02, 0x01];
+    covered.extend_from_slice(b"123456789");
     assert_eq!(
-        checker.check_message(data_id, &corrupted),
-        E2eStatus::CrcError
+        check_value(Check::Crc, &TEST_KEY, &freshness, b"123456789"),
+        reference.checksum(&covered)
     );
+    // No session: the epoch is four zero bytes. The key plays no part in a CRC.
+    let unbound = Freshness {
+        epoch: None,
+        ..freshness
+    };
+    covered[2..6].fill(0);
     assert_eq!(
-        checker.check_message(data_id ^ 1, &message),
-        E2eStatus::CrcError,
-        "wrong data id"
-    );
-    assert_eq!(checker.check_message(data_id, &message), E2eStatus::Initial);
-    assert_eq!(
-        checker.check_message(data_id, &message),
-        E2eStatus::Repeated
+        check_value(Check::Crc, &Key([0xA5; 16]), &unbound, b"123456789"),
+        reference.checksum(&covered)
     );
 }
 
 #[test]
-fn crc_is_ccitt_false_over_data_then_data_id() {
-    // CRC-16/CCITT-FALSE check value: "123456789" → 0x29B1; the data id is appended low byte
-    // first, so the E2E CRC equals the plain CRC of the concatenation.
-    let reference = crc::Crc::<u16>::new(&crc::CRC_16_IBM_3740);
-    assert_eq!(reference.checksum(b"123456789"), 0x29B1);
-    let mut concatenated = b"123456789".to_vec();
-    concatenated.extend_from_slice(&[0x12, 0x34]);
-    assert_eq!(crc(0x3412, b"123456789"), reference.checksum(&concatenated));
+fn the_mac_is_the_first_four_bytes_of_the_aes_cmac_tag() {
+    // RFC 4493, example 2: K = 2b7e1516 28aed2a6 abf71588 09cf4f3c,
+    // M = 6bc1bee2 2e409f96 e93d7e11 7393172a, T = 070a16b4 6b4d4144 f79bdd9d d04a287c.
+    // The ten freshness bytes are the first ten of M, the payload the other six.
+    let key = Key::from_hex("2b7e151628aed2a6abf7158809cf4f3c").unwrap();
+    let freshness = Freshness {
+        data_id: u16::from_le_bytes([0x6b, 0xc1]),
+        epoch: Some(Epoch::new(u32::from_le_bytes([0xbe, 0xe2, 0x2e, 0x40]))),
+        counter: u32::from_le_bytes([0x9f, 0x96, 0xe9, 0x3d]),
+    };
+    let payload = [0x7e, 0x11, 0x73, 0x93, 0x17, 0x2a];
+    assert_eq!(
+        check_value(Check::Mac, &key, &freshness, &payload),
+        u32::from_le_bytes([0x07, 0x0a, 0x16, 0xb4])
+    );
+    assert_ne!(
+        check_value(Check::Mac, &TEST_KEY, &freshness, &payload),
+        check_value(Check::Mac, &key, &freshness, &payload),
+        "the key matters"
+    );
+}
+
+/// The header as `e2e`'s module documentation gives it, computed here with `crc` and `cmac`
+/// directly: what a node written without this crate (or a `cantools` script) must produce.
+#[test]
+fn frames_on_the_wire_follow_the_documented_layout() {
+    use cmac::Mac;
+    let epoch = Epoch::new(0x0102_0304);
+    let session = Session::owned(TEST_KEY, epoch);
+    let counter: u32 = 0x0005_A1B2;
+    let freshness_bytes = |data_id: u16, epoch: u32, counter: u32| {
+        let mut bytes = data_id.to_le_bytes().to_vec();
+        bytes.extend_from_slice(&epoch.to_le_bytes());
+        bytes.extend_from_slice(&counter.to_le_bytes());
+        bytes
+    };
+
+    // A CRC-32C frame bound to the session.
+    let sync = AnyMessage::Sync(Sync {
+        tick: Tick::from_raw(0xDEAD_BEEF).unwrap(),
+    });
+    let frame = sync.encode(&session, counter).unwrap();
+    let data = frame.data();
+    assert_eq!(data[4..6], [0xB2, 0xA1], "low half of the counter");
+    assert_eq!(data[6..10], 0xDEAD_BEEF_u32.to_le_bytes(), "payload");
+    let mut covered = freshness_bytes(0xC010, epoch.raw(), counter);
+    covered.extend_from_slice(&data[6..10]);
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISCSI).checksum(&covered);
+    assert_eq!(data[..4], crc.to_le_bytes());
+    assert!(data[10..].iter().all(|&b| b == 0), "zero padding");
+
+    // A CMAC frame bound to the session.
+    let heartbeat = AnyMessage::TeleopHeartbeat(protocol::TeleopHeartbeat {
+        uptime: protocol::Millis::from_raw(1234).unwrap(),
+    });
+    let frame = heartbeat.encode(&session, counter).unwrap();
+    let data = frame.data();
+    let mut covered = freshness_bytes(0xC201, epoch.raw(), counter);
+    covered.extend_from_slice(&data[6..10]);
+    let mut mac = <cmac::Cmac<aes::Aes128> as Mac>::new_from_slice(&TEST_KEY.0).unwrap();
+    mac.update(&covered);
+    let tag = mac.finalize().into_bytes();
+    assert_eq!(data[..4], tag[..4]);
+
+    // An E-stop latch: CRC over data id 0xC000, zero epoch, low counter, action and source.
+    let latch = protocol::EStop::latch(protocol::NodeId::Tool);
+    let frame = AnyMessage::EStop(latch).encode(&session, counter).unwrap();
+    let data = frame.data();
+    let mut covered = freshness_bytes(0xC000, 0, counter & 0xFFFF);
+    covered.extend_from_slice(&data[6..8]);
+    let crc = crc::Crc::<u32>::new(&crc::CRC_32_ISCSI).checksum(&covered);
+    assert_eq!(data[..4], crc.to_le_bytes());
+    assert_eq!(data[6], protocol::EStopAction::Latch.raw());
+    assert_eq!(data[7], protocol::NodeId::Tool as u8);
+    // The classic frame of a panel is the first eight bytes of the same frame.
+    let classic = protocol::classic_latch(protocol::NodeId::Tool, counter as u16).unwrap();
+    assert_eq!(classic.data(), &data[..8]);
 }
 
 #[test]
-fn too_short_messages_are_never_verified() {
-    assert_eq!(verify(0, &[]), None);
-    assert_eq!(verify(0, &[1, 2, 3]), None);
+fn too_short_messages_have_no_header() {
+    assert_eq!(header(&[]), None);
+    assert_eq!(header(&[1, 2, 3, 4, 5]), None);
+    assert_eq!(header(&[1, 0, 0, 0, 0x34, 0x12]), Some((1, 0x1234)));
+    let freshness = Freshness {
+        data_id: 0,
+        epoch: None,
+        counter: 0,
+    };
+    let mut short = [0_u8; HEADER_LEN - 1];
+    assert_eq!(protect(Check::Crc, &TEST_KEY, &freshness, &mut short), None);
+    assert_eq!(short, [0; HEADER_LEN - 1], "nothing written");
 }
 
 #[test]
-fn a_jump_past_the_window_names_the_frames_skipped_and_a_step_back_none() {
-    let mut checker = checker_after(&[10]);
-    assert_eq!(checker.skipped_ahead(11), None, "in sequence");
-    assert_eq!(
-        checker.skipped_ahead(13),
-        None,
-        "inside the window: OkSomeLost counts it"
-    );
-    assert_eq!(checker.skipped_ahead(10), None, "a repeat");
-    assert_eq!(
-        checker.skipped_ahead(5),
-        None,
-        "behind: stale or replayed, not lost"
-    );
-    assert_eq!(checker.skipped_ahead(10u16.wrapping_sub(20)), None);
-    assert_eq!(checker.skipped_ahead(30), Some(19));
-    assert_eq!(checker.check_counter(30), E2eStatus::WrongSequence);
-    // A second jump counts from the pending one, so no frame is counted twice.
-    assert_eq!(checker.skipped_ahead(40), Some(9));
-    assert_eq!(checker.check_counter(40), E2eStatus::WrongSequence);
-    assert_eq!(
-        checker.skipped_ahead(40),
-        None,
-        "the pending counter again: a repeat"
-    );
-    assert_eq!(
-        checker.skipped_ahead(35),
-        Some(24),
-        "behind the pending counter but past the window: counted from the last accepted"
-    );
-    assert_eq!(
-        checker.skipped_ahead(41),
-        None,
-        "the sequence resynchronises here"
-    );
-    assert_eq!(checker.check_counter(41), E2eStatus::Initial);
-}
-
-#[test]
-fn half_the_counter_range_ahead_counts_as_behind() {
-    let checker = checker_after(&[10]);
-    assert_eq!(checker.skipped_ahead(10 + 0x7FFF), Some(0x7FFE));
-    assert_eq!(checker.skipped_ahead(10 + 0x8000), None);
-    // A pending counter half the range ahead is no reference either.
-    let mut checker = checker_after(&[10]);
-    assert_eq!(checker.check_counter(10 + 0x8000), E2eStatus::WrongSequence);
-    assert_eq!(checker.skipped_ahead(10 + 0x8005), None);
-}
-
-#[test]
-fn the_receiver_counts_frames_skipped_by_a_long_burst_as_lost() {
-    let mut receiver = protocol::Receiver::default();
-    let sync = |counter: u16| {
-        protocol::AnyMessage::Sync(protocol::Sync {
-            tick: protocol::Tick::from_raw(u32::from(counter)).unwrap(),
+fn the_receiver_counts_frames_lost_in_a_burst() {
+    let session = Session::owned(TEST_KEY, Epoch::new(3));
+    let mut receiver = Receiver::owner(session);
+    let sync = |counter: u32| {
+        AnyMessage::Sync(Sync {
+            tick: Tick::from_raw(counter).unwrap(),
         })
-        .encode(counter)
+        .encode(&session, counter)
         .unwrap()
     };
     for counter in [0, 1, 2] {
         let frame = sync(counter);
         receiver.receive(frame.id(), frame.data()).unwrap();
     }
-    // 30 frames lost in one burst (beyond the 10-frame window), then the sender goes on.
+    // 30 frames lost in one burst, then the sender goes on.
     let frame = sync(33);
-    assert!(receiver.receive(frame.id(), frame.data()).is_err());
+    assert_eq!(
+        receiver.receive(frame.id(), frame.data()).unwrap().status,
+        E2eStatus::OkSomeLost { lost: 30 }
+    );
     let frame = sync(34);
-    assert!(receiver.receive(frame.id(), frame.data()).is_ok());
+    assert_eq!(
+        receiver.receive(frame.id(), frame.data()).unwrap().status,
+        E2eStatus::Ok
+    );
     assert_eq!(receiver.counters().lost.raw(), 30);
     // A replay of an old frame is refused and counts no loss.
     let frame = sync(1);
     assert!(receiver.receive(frame.id(), frame.data()).is_err());
     assert_eq!(receiver.counters().lost.raw(), 30);
+    assert_eq!(receiver.counters().total(), 1);
 }
 
 #[test]
@@ -208,8 +407,171 @@ fn only_in_sequence_frames_are_accepted() {
     for status in [
         E2eStatus::Repeated,
         E2eStatus::WrongSequence,
-        E2eStatus::CrcError,
+        E2eStatus::CheckFailed,
     ] {
         assert!(!status.is_accepted(), "{status:?}");
+    }
+}
+
+fn any_check() -> impl Strategy<Value = Check> {
+    prop_oneof![Just(Check::Crc), Just(Check::Mac)]
+}
+
+fn any_epoch() -> impl Strategy<Value = Option<Epoch>> {
+    proptest::option::of(any::<u32>().prop_map(Epoch::new))
+}
+
+/// A genuine sender's history as a checker saw it: a first counter anywhere in the first
+/// `2^16 · 8` and gaps of up to half the counter range.
+fn history() -> impl Strategy<Value = (u32, Vec<u32>)> {
+    (
+        0_u32..(8 << 16),
+        proptest::collection::vec(
+            prop_oneof![4 => Just(1_u32), 2 => 2_u32..100, 1 => 100_u32..0x8000],
+            0..40,
+        ),
+    )
+}
+
+/// A checker that accepted the frames of `history`, and the last counter.
+fn replay_history(start: u32, gaps: &[u32]) -> (E2eChecker, u32) {
+    let mut checker = E2eChecker::new();
+    assert_eq!(
+        checker.check(start as u16, (start >> 16) + 1, |full| full == start),
+        E2eStatus::Initial
+    );
+    let mut last = start;
+    for &gap in gaps {
+        last += gap;
+        let expected = if gap == 1 {
+            E2eStatus::Ok
+        } else {
+            E2eStatus::OkSomeLost { lost: gap - 1 }
+        };
+        assert_eq!(offer(&mut checker, last), expected);
+    }
+    (checker, last)
+}
+
+proptest! {
+    /// Every gap short of half the counter range is in sequence, counted as lost, and the
+    /// checker follows the sender's full counter across any number of wraps of the low half.
+    #[test]
+    fn gaps_below_half_the_range_are_accepted_and_counted((start, gaps) in history()) {
+        let (checker, last) = replay_history(start, &gaps);
+        prop_assert_eq!(checker.last(), Some(last));
+    }
+
+    /// A genuine frame sent `age` frames before the last accepted one, replayed: a repeat, stale
+    /// while the low half can tell, and a failed check from half the counter range on — never
+    /// accepted, and the sequence goes on undisturbed.
+    #[test]
+    fn a_replayed_earlier_frame_is_refused_according_to_its_age(
+        (start, gaps) in history(),
+        age in prop_oneof![0_u32..0x100, 0x7F00_u32..0x8100, 0_u32..(6 << 16)],
+    ) {
+        let start = start + (6 << 16);
+        let (mut checker, last) = replay_history(start, &gaps);
+        let expected = match age {
+            0 => E2eStatus::Repeated,
+            1..=0x7FFF => E2eStatus::WrongSequence,
+            _ => E2eStatus::CheckFailed,
+        };
+        prop_assert_eq!(offer(&mut checker, last - age), expected);
+        prop_assert_eq!(checker.last(), Some(last));
+        prop_assert_eq!(offer(&mut checker, last + 1), E2eStatus::Ok);
+    }
+
+    /// A genuine frame half the counter range or more ahead cannot be placed: refused, and the
+    /// sequence is unchanged.
+    #[test]
+    fn a_frame_half_the_range_or_more_ahead_is_refused(
+        (start, gaps) in history(),
+        ahead in prop_oneof![0x8000_u32..0x8100, 0xFF00_u32..0x1_0100, 0x8000_u32..0x1000_0000],
+    ) {
+        let (mut checker, last) = replay_history(start, &gaps);
+        prop_assert_eq!(offer(&mut checker, last + ahead), E2eStatus::CheckFailed);
+        prop_assert_eq!(checker.last(), Some(last));
+    }
+
+    /// A frame whose check holds at no counter never enters or moves a sequence.
+    #[test]
+    fn a_forged_frame_never_moves_the_sequence(
+        (start, gaps) in history(),
+        low in any::<u16>(),
+        tries in 0_u32..300,
+    ) {
+        let mut fresh = E2eChecker::new();
+        prop_assert_eq!(fresh.check(low, tries, |_| false), E2eStatus::CheckFailed);
+        prop_assert_eq!(fresh.last(), None);
+        let (mut checker, last) = replay_history(start, &gaps);
+        prop_assert_eq!(offer_forged(&mut checker, low), E2eStatus::CheckFailed);
+        prop_assert_eq!(checker.last(), Some(last));
+    }
+
+    /// A first frame is found exactly when its high half is among those tried.
+    #[test]
+    fn a_first_frame_is_found_within_its_tries(sent in 0_u32..(600 << 16), tries in 0_u32..600) {
+        let mut checker = E2eChecker::new();
+        let status = checker.check(sent as u16, tries, |full| full == sent);
+        if sent >> 16 < tries {
+            prop_assert_eq!(status, E2eStatus::Initial);
+            prop_assert_eq!(checker.last(), Some(sent));
+        } else {
+            prop_assert_eq!(status, E2eStatus::CheckFailed);
+            prop_assert_eq!(checker.last(), None);
+        }
+    }
+
+    /// Protect, then verify at the same freshness: the check holds; with any one bit of check
+    /// value, counter or payload flipped, it does not (certain for CRC-32C, which detects every
+    /// burst of up to 32 bits; 2^-32 for the MAC).
+    #[test]
+    fn a_flipped_bit_in_a_protected_message_fails_its_check(
+        check in any_check(),
+        data_id in any::<u16>(),
+        epoch in any_epoch(),
+        counter in any::<u32>(),
+        payload in proptest::collection::vec(any::<u8>(), 1..58),
+        bit in any::<prop::sample::Index>(),
+    ) {
+        let freshness = Freshness { data_id, epoch, counter };
+        let message = protected(check, &TEST_KEY, &freshness, &payload);
+        let holds = |message: &[u8]| {
+            let (sent, low) = header(message).unwrap();
+            let at = Freshness { counter: counter & !0xFFFF | u32::from(low), ..freshness };
+            check_value(check, &TEST_KEY, &at, &message[HEADER_LEN..]) == sent
+        };
+        prop_assert!(holds(&message));
+        let bit = bit.index(message.len() * 8);
+        let mut flipped = message.clone();
+        flipped[bit / 8] ^= 1 << (bit % 8);
+        prop_assert!(!holds(&flipped), "bit {} flipped", bit);
+    }
+
+    /// The check covers the data id, the epoch and the full counter: a change of any one of
+    /// them changes it, as it must for a frame moved to another id, replayed from another
+    /// session or replayed from 2^16 frames ago to fail.
+    #[test]
+    fn the_check_binds_data_id_epoch_and_counter(
+        check in any_check(),
+        data_id in any::<u16>(),
+        epoch in any::<u32>(),
+        counter in any::<u32>(),
+        field in 0_usize..3,
+        other in any::<u32>(),
+        payload in proptest::collection::vec(any::<u8>(), 0..58),
+    ) {
+        let freshness = Freshness { data_id, epoch: Some(Epoch::new(epoch)), counter };
+        let changed = match field {
+            0 => Freshness { data_id: other as u16, ..freshness },
+            1 => Freshness { epoch: Some(Epoch::new(other)), ..freshness },
+            _ => Freshness { counter: other, ..freshness },
+        };
+        prop_assume!(changed != freshness);
+        prop_assert_ne!(
+            check_value(check, &TEST_KEY, &freshness, &payload),
+            check_value(check, &TEST_KEY, &changed, &payload)
+        );
     }
 }

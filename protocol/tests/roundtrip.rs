@@ -8,14 +8,34 @@ use protocol::*;
 
 proptest! {
     #[test]
-    fn every_message_round_trips(message in common::any_message(), counter in any::<u16>()) {
-        let frame = message.encode(counter).unwrap();
+    fn every_message_round_trips(message in common::any_message(), counter in any::<u32>()) {
+        let frame = message.encode(&common::controller_session(), counter).unwrap();
         prop_assert_eq!(frame.id(), message.id().raw());
         prop_assert_eq!(frame.data().len(), message.id().layout().wire_len);
         let decoded = decode_frame(frame.id(), frame.data()).unwrap();
         prop_assert_eq!(decoded.message, message);
-        prop_assert_eq!(decoded.counter, counter);
+        prop_assert_eq!(decoded.counter, counter as u16, "the low half travels");
         prop_assert_eq!(decoded.id, message.id());
+    }
+
+    /// What the sender seals, the receivers of its session accept: the check value the encoder
+    /// writes is the one the receiver computes, for every message and both kinds of check.
+    #[test]
+    fn every_sealed_message_is_accepted_by_the_session(
+        message in common::any_message(),
+        counter in 0_u32..0x1_0000,
+    ) {
+        prop_assume!(!matches!(message, AnyMessage::Announce(_)));
+        let frame = message.encode(&common::controller_session(), counter).unwrap();
+        for mut rx in [
+            Receiver::owner(common::controller_session()),
+            common::joined_member(common::EPOCH),
+        ] {
+            let accepted = rx.receive(frame.id(), frame.data()).unwrap();
+            prop_assert_eq!(accepted.message, message);
+            prop_assert_eq!(accepted.status, E2eStatus::Initial);
+            prop_assert_eq!(rx.counters().total(), 0);
+        }
     }
 
     #[test]
@@ -44,8 +64,13 @@ proptest! {
 
     #[test]
     fn arbitrary_bytes_never_panic_the_decoder(id in 0_u16..0x800, data in proptest::collection::vec(any::<u8>(), 0..=64)) {
-        let mut rx = Receiver::default();
-        let _ = rx.receive(id, &data);
+        for mut rx in [
+            Receiver::owner(common::controller_session()),
+            Receiver::member(TEST_KEY),
+            common::joined_member(common::EPOCH),
+        ] {
+            let _ = rx.receive(id, &data);
+        }
         let _ = decode_frame(id, &data);
     }
 }
@@ -64,9 +89,10 @@ fn every_id_maps_back_to_itself_and_has_a_unique_index() {
 }
 
 #[test]
-fn estop_has_the_highest_priority_then_sync_then_commands() {
+fn estop_has_the_highest_priority_then_sync_then_the_announcement_then_commands() {
     assert_eq!(MessageId::EStop.raw(), 0);
-    assert!(MessageId::Sync.raw() < MessageId::LegTargets.raw());
+    assert!(MessageId::Sync.raw() < MessageId::Announce.raw());
+    assert!(MessageId::Announce.raw() < MessageId::LegTargets.raw());
     assert!(MessageId::WheelCommand.raw() < MessageId::LegFeedback(Leg::Fl).raw());
     assert!(MessageId::Imu.raw() < MessageId::TeleopCommand.raw());
     assert!(MessageId::TeleopHeartbeat.raw() < MessageId::ControllerStatus.raw());

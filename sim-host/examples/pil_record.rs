@@ -22,7 +22,7 @@ use host_can::bus::{Bus, BusError};
 use host_can::inproc_bus::InprocBus;
 use host_can::port::{BusPort, Wait};
 use pil_format::Recording;
-use protocol::TeleopMode;
+use protocol::{Epoch, Session, TeleopMode, TEST_KEY};
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
 use sim_host::robot::imu::ImuNoise;
@@ -56,7 +56,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ImuNoise::default(),
     )?;
     let config = firmware_config(CONTROL_HZ).ok_or("control rate")?;
-    let mut node = Node::new(config).map_err(|e| format!("{e:?}"))?;
+    let session = Session::owned(TEST_KEY, Epoch::new(pil_format::PIL_EPOCH));
+    let mut node = Node::new(config, session).map_err(|e| format!("{e:?}"))?;
     let bus = InprocBus::new();
     let mut sim_bus = bus.endpoint();
     let mut controller_bus = bus.endpoint();
@@ -68,6 +69,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut ticks: Vec<Vec<(u16, Vec<u8>)>> = Vec::new();
     let mut modes = Vec::new();
     let peers = |cycle: u32| -> Result<(), RunError> {
+        while let Some(frame) = teleop_bus.recv(std::time::Duration::ZERO)? {
+            teleop.observe(&frame);
+        }
         for frame in teleop.frames(u64::from(cycle) * period_us)? {
             teleop_bus.send(&frame)?;
         }

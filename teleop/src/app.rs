@@ -106,12 +106,9 @@ impl App {
     /// Takes a frame seen on the bus at `now_ms`.
     pub fn observe(&mut self, now_ms: u64, frame: &Frame) {
         self.status.observe(now_ms, frame);
-        // Only a status frame heard now confirms an E-stop, never the one stored from before.
-        if frame.id() == protocol::MessageId::ControllerStatus.raw() {
-            if let Some(controller) = self.status.controller(now_ms) {
-                self.operator.observe_controller(controller.mode);
-            }
-        }
+        // Only an authentic status frame heard now confirms an E-stop, never one stored from
+        // before; the announcement joins the controller's session.
+        self.operator.observe(frame);
     }
 
     /// Takes the in-process simulator's ground truth.

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
 use host_can::bus::{Bus, BusError};
-use protocol::{ControllerMode, EncodeError, Frame, MessageId};
+use protocol::{ControllerMode, EncodeError, Frame};
 use teleop_core::bus_status::BusStatus;
 use teleop_core::keys::Action;
 use teleop_core::operator::Operator;
@@ -43,7 +43,11 @@ pub struct ScriptReport {
     pub interrupted: bool,
 }
 
-/// Presses `key` and keeps the command and heartbeat going for `hold`.
+/// How long `send` keeps STOP before the key: two command periods, so that the controller's
+/// interlock has seen the STOP before the motion arrives.
+const ARM_MS: u64 = 2 * teleop_core::operator::PERIOD_MS;
+
+/// Presses `key` (after a STOP, which the controller's interlock wants first) and keeps the command and heartbeat going for `hold`.
 pub fn send(
     bus: &mut dyn Bus,
     key: Action,
@@ -51,11 +55,21 @@ pub fn send(
     stop: &AtomicBool,
 ) -> Result<ScriptReport, ScriptError> {
     let mut operator = Operator::new();
-    operator.press(0, key);
-    serve(bus, hold, stop, |now_ms, controller| {
-        // An E-stop is sent again until the controller reports it.
-        if let Some(mode) = controller {
-            operator.observe_controller(mode);
+    // The controller starts interlocked: a motion key is sent after a STOP, as a script does.
+    let motion = key;
+    operator.press(0, Action::Mode(protocol::TeleopMode::Stop));
+    // A latch goes out at once, before any session is joined.
+    let mut pressed = matches!(motion, Action::EStop);
+    if pressed {
+        operator.press(0, motion);
+    }
+    serve(bus, hold, stop, |now_ms, heard| {
+        for frame in heard {
+            operator.observe(frame);
+        }
+        if !pressed && operator.joined() && now_ms >= ARM_MS {
+            operator.press(now_ms, motion);
+            pressed = true;
         }
         operator.poll(now_ms)
     })
@@ -72,7 +86,10 @@ pub fn run(
     let mut teleop = ScriptedTeleop::new(scenario.plan());
     let mut started = 0;
     let hold = Duration::from_secs_f64(scenario.duration_s);
-    serve(bus, hold, stop, |now_ms, _| {
+    serve(bus, hold, stop, |now_ms, heard| {
+        for frame in heard {
+            teleop.observe(frame);
+        }
         let now_us = now_ms.saturating_mul(1_000);
         while scenario
             .steps
@@ -90,7 +107,7 @@ fn serve(
     bus: &mut dyn Bus,
     hold: Duration,
     stop: &AtomicBool,
-    mut frames_due: impl FnMut(u64, Option<ControllerMode>) -> Result<Vec<Frame>, EncodeError>,
+    mut frames_due: impl FnMut(u64, &[Frame]) -> Result<Vec<Frame>, EncodeError>,
 ) -> Result<ScriptReport, ScriptError> {
     let start = Instant::now();
     let mut status = BusStatus::default();
@@ -100,12 +117,14 @@ fn serve(
         last_mode: None,
         interrupted: false,
     };
-    // The controller's mode from a status frame heard since the last pass (not a stored one:
-    // a status from before an E-stop must not confirm it).
-    let mut heard = None;
+    // The frames heard since the last pass (a status heard before an E-stop must not confirm
+    // it, so only new ones are handed on).
+    let mut heard = Vec::new();
     loop {
         let now_ms = u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX);
-        for frame in frames_due(now_ms, heard.take()).map_err(ScriptError::Encode)? {
+        let due = frames_due(now_ms, &heard).map_err(ScriptError::Encode)?;
+        heard.clear();
+        for frame in due {
             bus.send(&frame)?;
             report.frames_sent += 1;
         }
@@ -115,9 +134,7 @@ fn serve(
             };
             status.observe(now_ms, &frame);
             report.frames_heard += 1;
-            if frame.id() == MessageId::ControllerStatus.raw() {
-                heard = status.controller(now_ms).map(|c| c.mode).or(heard);
-            }
+            heard.push(frame);
         }
         if let Some(controller) = status.controller(now_ms) {
             report.last_mode = Some(controller.mode);

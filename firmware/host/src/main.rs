@@ -3,6 +3,7 @@
 // Functions stay short enough to read whole (clippy.toml: 80 lines); tests may run longer.
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
@@ -10,9 +11,11 @@ use std::time::Duration;
 
 use clap::{Parser, ValueEnum};
 use firmware_host::runner::{self, Clock, RunnerConfig};
+use firmware_host::state::{self, StateFile};
 use host_can::fault_plan::Faults;
 use host_can::faulty_bus::FaultyBus;
 use host_can::socketcan_bus::SocketCanBus;
+use protocol::{Epoch, Session};
 
 /// The hybrid robot's firmware as a host process on a CAN interface.
 ///
@@ -48,6 +51,18 @@ struct Cli {
     /// SYNC-delimited cycles). SYNC is never faulted.
     #[arg(long, value_name = "PLAN", default_value = "")]
     faults: Faults,
+    /// The bus key: a file holding 32 hexadecimal digits, readable by this account only.
+    /// Without it, the public test key of simulation and CI.
+    #[arg(long, value_name = "PATH")]
+    key_file: Option<PathBuf>,
+    /// Where the controller keeps its session epoch and E-stop latch across restarts
+    /// (default: $XDG_STATE_HOME/hybrid-robot/firmware-host.toml, or under ~/.local/state).
+    #[arg(long, value_name = "PATH")]
+    state_file: Option<PathBuf>,
+    /// Open a session with at least this epoch (after a lost state file: above the last one
+    /// the controller announced).
+    #[arg(long)]
+    epoch: Option<u32>,
 }
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
@@ -84,7 +99,33 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
     };
+    let key = match host_can::key_file::load(cli.key_file.as_deref()) {
+        Ok(key) => key,
+        Err(e) => {
+            eprintln!("firmware-host: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let Some(state_path) = cli.state_file.clone().or_else(state::default_path) else {
+        eprintln!("firmware-host: no HOME or XDG_STATE_HOME: give --state-file PATH");
+        return ExitCode::FAILURE;
+    };
+    let (mut state, epoch, latched) = match StateFile::start(&state_path, cli.epoch.map(Epoch::new))
+    {
+        Ok(started) => started,
+        Err(e) => {
+            eprintln!("firmware-host: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    if latched {
+        tracing::warn!(
+            "the E-stop was latched when the last run ended: it stays latched until released"
+        );
+    }
     let config = RunnerConfig {
+        session: Session::owned(key, epoch),
+        latched,
         clock: match cli.clock {
             ClockArg::Lockstep => Clock::Lockstep,
             ClockArg::Wall => Clock::Wall,
@@ -97,9 +138,11 @@ fn main() -> ExitCode {
         bus = %cli.bus,
         clock = ?cli.clock,
         control_hz = cli.control_hz,
+        epoch = epoch.raw(),
+        state = %state_path.display(),
         "firmware running"
     );
-    match runner::run(&mut bus, config, &stop) {
+    match runner::run(&mut bus, config, &stop, Some(&mut state)) {
         Ok(stats) => {
             println!(
                 "ticks {} | frames in {} out {} | rejected {:?} | overruns {}",

@@ -18,7 +18,9 @@ use firmware::node::Node;
 use firmware::time::{Tick, TickRate};
 use host_can::port::{BusPort, Wait};
 use host_can::{Bus, BusError};
-use protocol::RejectCause;
+use protocol::{RejectCause, Session};
+
+use crate::state::{StateError, StateFile};
 
 /// Most frames taken in one call of the service loop: a bound for a flooded bus, far above
 /// what one control period carries (a call that reaches it is simply followed by another).
@@ -28,6 +30,10 @@ const RX_LIMIT: u32 = 4096;
 /// Lockstep: how long one call of the service loop waits for the simulator's frames before the
 /// runner looks at its stop flag and idle timeout again.
 const LOCKSTEP_POLL: Duration = Duration::from_millis(50);
+
+/// Lockstep: how often the session is announced while no SYNC comes (a simulator started after
+/// the firmware joins within this, then starts its clock).
+const ANNOUNCE_IDLE: Duration = Duration::from_millis(100);
 
 /// How the runner keeps time.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -41,6 +47,10 @@ pub enum Clock {
 /// Runner settings.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunnerConfig {
+    /// The session this controller opens (its key and this start's epoch).
+    pub session: Session,
+    /// Whether an E-stop was latched when the last run ended: the node starts latched.
+    pub latched: bool,
     /// Clock.
     pub clock: Clock,
     /// Control rate, Hz.
@@ -84,24 +94,48 @@ pub enum RunnerError {
     /// Lockstep: the simulator went quiet.
     #[error("no SYNC for {0:?}: is the simulator running on this bus in lockstep mode?")]
     NoSync(Duration),
+    /// The state file could not be written.
+    #[error(transparent)]
+    State(#[from] StateError),
 }
 
-/// Runs the firmware on `bus` until `stop` is set, `max_ticks` are done, or an error.
+/// Runs the firmware on `bus` until `stop` is set, `max_ticks` are done, or an error. With a
+/// `state` file, a change of the E-stop latch is written to it before the next tick.
 pub fn run(
     bus: &mut dyn Bus,
     config: RunnerConfig,
     stop: &AtomicBool,
+    state: Option<&mut StateFile>,
 ) -> Result<RunnerStats, RunnerError> {
     let rate = TickRate::new(config.control_hz).ok_or(RunnerError::Rate(config.control_hz))?;
-    let mut node = Node::new(Config::ROBOT.at_rate(rate)).map_err(RunnerError::Config)?;
+    let mut node =
+        Node::new(Config::ROBOT.at_rate(rate), config.session).map_err(RunnerError::Config)?;
+    if config.latched {
+        node.restore_latch(Tick(0));
+    }
     let mut stats = RunnerStats::default();
+    let mut keeper = LatchKeeper { state };
     let result = match config.clock {
-        Clock::Lockstep => lockstep(bus, &mut node, config, stop, &mut stats),
-        Clock::Wall => wall(bus, &mut node, rate, config, stop, &mut stats),
+        Clock::Lockstep => lockstep(bus, &mut node, config, stop, &mut stats, &mut keeper),
+        Clock::Wall => wall(bus, &mut node, rate, config, stop, &mut stats, &mut keeper),
     };
     stats.rejected = node.reject_counters().rejected.map(|n| u64::from(n.raw()));
     send_stop(bus, &mut node, &mut stats)?;
     result.map(|()| stats)
+}
+
+/// Writes the latch to the state file when it changes.
+struct LatchKeeper<'a> {
+    state: Option<&'a mut StateFile>,
+}
+
+impl LatchKeeper<'_> {
+    fn keep(&mut self, node: &Node) -> Result<(), RunnerError> {
+        match self.state.as_deref_mut() {
+            Some(state) => Ok(state.record_latch(node.estop_latched())?),
+            None => Ok(()),
+        }
+    }
 }
 
 fn done(config: &RunnerConfig, stats: &RunnerStats, stop: &AtomicBool) -> bool {
@@ -114,14 +148,26 @@ fn lockstep(
     config: RunnerConfig,
     stop: &AtomicBool,
     stats: &mut RunnerStats,
+    keeper: &mut LatchKeeper<'_>,
 ) -> Result<(), RunnerError> {
     // Frames before a SYNC belong to the tick it names; until the first, to tick 0.
     let mut next = Tick(0);
     let mut last_sync = Instant::now();
+    let mut last_announce: Option<Instant> = None;
     while !done(&config, stats, stop) {
-        let mut port = BusPort::new(bus, Wait::Until(Instant::now() + LOCKSTEP_POLL));
+        // Ticking, the node announces on its schedule; waiting for SYNC, the runner does.
+        let idle = stats.ticks == 0 || last_sync.elapsed() >= ANNOUNCE_IDLE;
+        if idle && last_announce.is_none_or(|t| t.elapsed() >= ANNOUNCE_IDLE) {
+            if let Some(frame) = node.announce_frame() {
+                let mut port = BusPort::new(&mut *bus, Wait::Never);
+                stats.frames_out += u64::from(service::send_all(&mut port, &[frame])?);
+            }
+            last_announce = Some(Instant::now());
+        }
+        let mut port = BusPort::new(&mut *bus, Wait::Until(Instant::now() + LOCKSTEP_POLL));
         let received = service::receive(node, next, &mut port, Drain::ThroughSync, RX_LIMIT)?;
         stats.frames_in += u64::from(received.frames);
+        keeper.keep(node)?;
         let Some(sync_tick) = received.sync_tick else {
             if let Some(limit) = config.idle_timeout {
                 if last_sync.elapsed() > limit {
@@ -147,6 +193,7 @@ fn wall(
     config: RunnerConfig,
     stop: &AtomicBool,
     stats: &mut RunnerStats,
+    keeper: &mut LatchKeeper<'_>,
 ) -> Result<(), RunnerError> {
     let period = Duration::from_nanos(1_000_000_000 / u64::from(rate.hz()));
     let start = Instant::now();
@@ -158,6 +205,7 @@ fn wall(
         let mut port = BusPort::new(&mut *bus, Wait::Never);
         let received = service::receive(node, tick, &mut port, Drain::All, RX_LIMIT)?;
         stats.frames_in += u64::from(received.frames);
+        keeper.keep(node)?;
         let sent = service::transmit(node, tick, &mut port)?;
         stats.frames_out += u64::from(sent.sent);
         stats.ticks += 1;

@@ -9,6 +9,7 @@ use cortex_m_rt::{entry, exception, ExceptionFrame};
 use cortex_m_semihosting::{debug, hio};
 use firmware::node::service::{self, Drain};
 use firmware::{Config, Node, Tick, TickRate};
+use protocol::{Epoch, Session, TEST_KEY};
 
 use crate::inputs::{Inputs, MAX_FRAMES};
 use crate::line::Line;
@@ -66,7 +67,8 @@ fn main() -> ! {
     let Some(rate) = TickRate::new(inputs.control_hz) else {
         fail("bad control rate")
     };
-    let Ok(mut node) = Node::new(Config::ROBOT.at_rate(rate)) else {
+    let session = Session::owned(TEST_KEY, Epoch::new(pil_format::PIL_EPOCH));
+    let Ok(mut node) = Node::new(Config::ROBOT.at_rate(rate), session) else {
         fail("config rejected")
     };
     let mut port = Recorded::new();

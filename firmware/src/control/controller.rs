@@ -203,6 +203,7 @@ impl Controller {
                 }
             }
             AnyMessage::Sync(_)
+            | AnyMessage::Announce(_)
             | AnyMessage::LegTargets(_)
             | AnyMessage::WheelCommand(_)
             | AnyMessage::ControllerStatus(_)
@@ -286,6 +287,9 @@ impl Controller {
         }
         if self.link_degraded {
             faults = faults.with(FaultFlags::LINK_DEGRADED);
+        }
+        if self.teleop.interlocked() {
+            faults = faults.with(FaultFlags::AWAITING_STOP);
         }
         let attitude = self.sensors.attitude;
         Status {
@@ -383,6 +387,10 @@ impl Controller {
         if next == State::Hold {
             // Unarmed, the targets already follow the measured positions every tick.
             self.follow_measured();
+        }
+        if self.state == State::EStop {
+            // A release moves nothing by itself: the operator sends STOP, then a motion.
+            self.teleop.interlock();
         }
         self.state = next;
     }

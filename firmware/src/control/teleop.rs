@@ -1,7 +1,13 @@
 //! What the operator asked for. Mode requests are edges: a command acts when its mode differs
-//! from the previous command's, so a teleop that keeps repeating `W` after an E-stop clear, a
-//! fault reset or a lost heartbeat does not restart the motion by itself — the operator has to
-//! press a key. Body height and speed scale are levels and apply on every command.
+//! from the previous command's, so a teleop that keeps repeating `W` after a fault reset does
+//! not restart the motion by itself — the operator has to press a key. Body height and speed
+//! scale are levels and apply on every command.
+//!
+//! On top of the edges sits the **restart interlock** (IEC 60204-1, no unexpected start-up):
+//! after the controller starts, after an E-stop release and after the operator was lost, no
+//! request but STOP acts until a STOP has arrived; then the next new request acts. A teleop
+//! that was holding `W` through a controller restart therefore moves nothing until its
+//! operator presses `X` and then `W`.
 
 use protocol::{TeleopCommand, TeleopMode};
 
@@ -18,10 +24,12 @@ pub struct Teleop {
     pub speed_scale: f32,
     watchdog: Watchdog,
     alive: bool,
+    interlocked: bool,
 }
 
 impl Teleop {
-    /// No operator yet: full speed scale, nominal height, watchdog of `timeout_ticks`.
+    /// No operator yet: full speed scale, nominal height, watchdog of `timeout_ticks`, and
+    /// the interlock engaged.
     pub const fn new(timeout_ticks: u32) -> Self {
         Self {
             last_mode: None,
@@ -29,10 +37,12 @@ impl Teleop {
             speed_scale: 1.0,
             watchdog: Watchdog::new(timeout_ticks),
             alive: false,
+            interlocked: true,
         }
     }
 
-    /// Records a command; returns the mode if it is a new request.
+    /// Records a command; returns the mode if it is a new request the interlock lets through
+    /// (any STOP, which also releases the interlock; anything else only once released).
     pub fn command(&mut self, now: Tick, command: &TeleopCommand) -> Option<TeleopMode> {
         self.watchdog.feed(now);
         self.alive = true;
@@ -40,7 +50,21 @@ impl Teleop {
         self.speed_scale = crate::math::clamp(command.speed_scale.si() * 0.01, 0.0, 1.0);
         let new = self.last_mode != Some(command.mode);
         self.last_mode = Some(command.mode);
-        new.then_some(command.mode)
+        if command.mode == TeleopMode::Stop {
+            self.interlocked = false;
+            return Some(command.mode);
+        }
+        (new && !self.interlocked).then_some(command.mode)
+    }
+
+    /// Engages the interlock: nothing but STOP acts until a STOP arrives.
+    pub fn interlock(&mut self) {
+        self.interlocked = true;
+    }
+
+    /// Whether the interlock holds motion back until a STOP.
+    pub fn interlocked(&self) -> bool {
+        self.interlocked
     }
 
     /// Records a heartbeat.
@@ -54,10 +78,11 @@ impl Teleop {
         self.watchdog.expired(now)
     }
 
-    /// `true` exactly once when a live operator falls silent.
+    /// `true` exactly once when a live operator falls silent; engages the interlock.
     pub fn just_lost(&mut self, now: Tick) -> bool {
         if self.alive && self.stale(now) {
             self.alive = false;
+            self.interlocked = true;
             true
         } else {
             false

@@ -64,16 +64,8 @@ impl LinkMonitor {
     pub fn record(&mut self, status: E2eStatus) {
         self.received = self.received.saturating_add(1);
         if let E2eStatus::OkSomeLost { lost } = status {
-            self.lost = self.lost.saturating_add(u32::from(lost));
+            self.lost = self.lost.saturating_add(lost);
         }
-    }
-
-    /// Records one frame the receiver refused because its counter jumped ahead of the window
-    /// after `lost` missing frames (a burst longer than the window): one frame received and
-    /// `lost` lost, so that loss in long bursts weighs as much as scattered loss.
-    pub fn record_skipped(&mut self, lost: u16) {
-        self.received = self.received.saturating_add(1);
-        self.lost = self.lost.saturating_add(u32::from(lost));
     }
 
     /// Called once per control tick: when the window that started `window_ticks` ago is

@@ -22,12 +22,14 @@ pub mod service;
 use heapless::Vec;
 use protocol::busload::SCHEDULE;
 use protocol::{
-    Angle, AnyMessage, BodyHeight, ControllerStatus, DecodeError, DriveEnable, E2eCounter, Frame,
-    LegTargets, MessageId, Receiver, RejectCounters, Torque, WheelCommand,
+    Angle, Announce, AnyMessage, BodyHeight, ControllerStatus, DecodeError, DriveEnable, EStop,
+    EStopAction, Frame, LegTargets, MessageId, NodeId, Receiver, RejectCounters, ReleaseToken,
+    Sender, Session, Torque, WheelCommand, WireVersion,
 };
 
 use crate::config::Config;
 use crate::control::controller::{ConfigError, Controller, Output};
+use crate::control::fsm::State;
 use crate::time::Tick;
 use link::LinkMonitor;
 use rate_limit::TickBudget;
@@ -42,19 +44,10 @@ use rate_limit::TickBudget;
 pub const TELEOP_COMMANDS_PER_TICK: u8 = 2;
 
 /// Most frames the node sends in one tick.
-pub const MAX_FRAMES_PER_TICK: usize = 4;
+pub const MAX_FRAMES_PER_TICK: usize = 5;
 
 /// Frames to put on the bus this tick, highest priority first.
 pub type TickFrames = Vec<Frame, MAX_FRAMES_PER_TICK>;
-
-/// Rolling counters of the frames this node sends.
-#[derive(Debug, Clone, Copy, Default)]
-struct TxCounters {
-    leg_targets: E2eCounter,
-    wheel_command: E2eCounter,
-    status: E2eCounter,
-    reject_counters: E2eCounter,
-}
 
 /// The controller with its receive checks and its transmit schedule.
 #[derive(Debug, Clone)]
@@ -63,13 +56,17 @@ pub struct Node {
     teleop_budget: TickBudget,
     link: LinkMonitor,
     controller: Controller,
-    tx: TxCounters,
+    sender: Sender,
+    release_token: ReleaseToken,
+    announced: bool,
     encode_failures: u32,
 }
 
 impl Node {
-    /// A node running `config`.
-    pub fn new(config: Config) -> Result<Self, ConfigError> {
+    /// A node running `config` in `session`, the one this controller opens: its epoch must
+    /// be greater than any this controller announced before (see [`protocol::session`]).
+    /// The node announces it on its first tick.
+    pub fn new(config: Config, session: Session) -> Result<Self, ConfigError> {
         let link = LinkMonitor::new(
             config.rate.ticks_from_ms(config.link_window_ms),
             config.link_degrade_permille,
@@ -77,13 +74,36 @@ impl Node {
         )
         .ok_or(ConfigError::LinkMonitor)?;
         Ok(Self {
-            receiver: Receiver::default(),
+            receiver: Receiver::owner(session),
             teleop_budget: TickBudget::new(TELEOP_COMMANDS_PER_TICK),
             link,
             controller: Controller::new(config)?,
-            tx: TxCounters::default(),
+            sender: Sender::new(),
+            release_token: ReleaseToken::new(0),
+            announced: false,
             encode_failures: 0,
         })
+    }
+
+    /// Latches the E-stop as a frame would, for a controller that restarts with a latch it
+    /// persisted (the latched E-stop survives a restart; only a fresh release clears it).
+    pub fn restore_latch(&mut self, now: Tick) {
+        self.act(now, &AnyMessage::EStop(EStop::latch(NodeId::Controller)));
+    }
+
+    /// Whether the E-stop is latched: what a board persists so that it survives a restart.
+    pub fn estop_latched(&self) -> bool {
+        self.controller.state() == State::EStop
+    }
+
+    /// The session this node owns.
+    pub fn session(&self) -> &Session {
+        self.receiver.session()
+    }
+
+    /// The token a release of the present latch must echo (published in the status).
+    pub fn release_token(&self) -> ReleaseToken {
+        self.release_token
     }
 
     /// The controller inside.
@@ -120,35 +140,39 @@ impl Node {
     /// so their flood adds at most 2 frames per tick: at 20 % loss the measure still reads about
     /// 15 % at 250 Hz and 12 % at 1 kHz.
     pub fn on_frame(&mut self, now: Tick, raw_id: u16, data: &[u8]) -> Result<(), DecodeError> {
-        let lost_before = self.receiver.counters().lost.raw();
-        let accepted = match self.receiver.receive(raw_id, data) {
-            Ok(accepted) => accepted,
-            Err(error) => {
-                // A counter that jumped past the window after a long burst of loss is refused
-                // (the sequence resynchronises on the next frame), but the frames it skipped
-                // were lost and the link monitor counts them.
-                let skipped = self
-                    .receiver
-                    .counters()
-                    .lost
-                    .raw()
-                    .wrapping_sub(lost_before);
-                if skipped > 0 && raw_id != MessageId::TeleopHeartbeat.raw() {
-                    self.link.record_skipped(skipped);
-                }
-                return Err(error);
-            }
-        };
+        let accepted = self.receiver.receive(raw_id, data)?;
         if matches!(accepted.message, AnyMessage::TeleopCommand(_)) && !self.teleop_budget.take() {
-            let error = DecodeError::RateLimited { id: raw_id };
-            self.receiver.refuse(error);
-            return Err(error);
+            return Err(self.refuse(DecodeError::RateLimited { id: raw_id }));
+        }
+        if let AnyMessage::EStop(EStop {
+            action: EStopAction::Clear,
+            token,
+            ..
+        }) = accepted.message
+        {
+            if !self.estop_latched() || token != self.release_token {
+                return Err(self.refuse(DecodeError::StaleRelease { id: raw_id }));
+            }
         }
         if !matches!(accepted.message, AnyMessage::TeleopHeartbeat(_)) {
             self.link.record(accepted.status);
         }
-        self.controller.on_message(now, &accepted.message);
+        self.act(now, &accepted.message);
         Ok(())
+    }
+
+    fn refuse(&mut self, error: DecodeError) -> DecodeError {
+        self.receiver.refuse(error);
+        error
+    }
+
+    /// Hands an accepted message to the controller; a new latch gets a new release token.
+    fn act(&mut self, now: Tick, message: &AnyMessage) {
+        let latched_before = self.estop_latched();
+        self.controller.on_message(now, message);
+        if self.estop_latched() && !latched_before {
+            self.release_token = self.release_token.next();
+        }
     }
 
     /// Runs one control tick and returns its output and the frames due. The frames received
@@ -167,6 +191,10 @@ impl Node {
                 .is_some_and(|slot| slot.sends_in(now.0, hz))
         };
         let mut frames = TickFrames::new();
+        if due(MessageId::Announce) || !self.announced {
+            self.announced = true;
+            self.push(&mut frames, &self.announcement());
+        }
         if due(MessageId::LegTargets) {
             let message = AnyMessage::LegTargets(LegTargets {
                 enable: if output.legs_enabled {
@@ -176,15 +204,13 @@ impl Node {
                 },
                 position: output.leg_targets_rad.map(Angle::saturating_from_si),
             });
-            let counter = self.tx.leg_targets.advance();
-            self.push(&mut frames, &message, counter);
+            self.push(&mut frames, &message);
         }
         if due(MessageId::WheelCommand) {
             let message = AnyMessage::WheelCommand(WheelCommand {
                 torque: output.wheel_torque_nm.map(Torque::saturating_from_si),
             });
-            let counter = self.tx.wheel_command.advance();
-            self.push(&mut frames, &message, counter);
+            self.push(&mut frames, &message);
         }
         if due(MessageId::ControllerStatus) {
             let status = output.status;
@@ -195,14 +221,13 @@ impl Node {
                 body_height: BodyHeight::saturating_from_si(status.body_height_m),
                 pitch: Angle::saturating_from_si(status.pitch_rad),
                 roll: Angle::saturating_from_si(status.roll_rad),
+                release_token: self.release_token,
             });
-            let counter = self.tx.status.advance();
-            self.push(&mut frames, &message, counter);
+            self.push(&mut frames, &message);
         }
         if due(MessageId::RejectCounters) {
             let message = AnyMessage::RejectCounters(*self.receiver.counters());
-            let counter = self.tx.reject_counters.advance();
-            self.push(&mut frames, &message, counter);
+            self.push(&mut frames, &message);
         }
         (output, frames)
     }
@@ -220,18 +245,36 @@ impl Node {
                 .joint_position_rad
                 .map(Angle::saturating_from_si),
         });
-        let counter = self.tx.leg_targets.advance();
-        self.push(&mut frames, &legs, counter);
+        self.push(&mut frames, &legs);
         let wheels = AnyMessage::WheelCommand(WheelCommand {
             torque: [Torque::saturating_from_si(0.0); 2],
         });
-        let counter = self.tx.wheel_command.advance();
-        self.push(&mut frames, &wheels, counter);
+        self.push(&mut frames, &wheels);
         frames
     }
 
-    fn push(&mut self, frames: &mut TickFrames, message: &AnyMessage, counter: u16) {
-        match message.encode(counter) {
+    /// The session announcement sealed for the bus, for a runner that announces while it
+    /// waits for its first tick (in lockstep the node ticks only on SYNC, and the simulator
+    /// sends no SYNC before it has joined the session).
+    pub fn announce_frame(&mut self) -> Option<Frame> {
+        let message = self.announcement();
+        self.sender.seal(self.receiver.session(), &message).ok()
+    }
+
+    /// The session announcement: wire version and this controller's epoch.
+    pub fn announcement(&self) -> AnyMessage {
+        AnyMessage::Announce(Announce {
+            version: WireVersion::THIS,
+            epoch: self
+                .receiver
+                .session()
+                .epoch()
+                .unwrap_or(protocol::Epoch::new(0)),
+        })
+    }
+
+    fn push(&mut self, frames: &mut TickFrames, message: &AnyMessage) {
+        match self.sender.seal(self.receiver.session(), message) {
             Ok(frame) => {
                 if frames.push(frame).is_err() {
                     self.encode_failures = self.encode_failures.saturating_add(1);

@@ -21,6 +21,20 @@ use crate::timer::ControlTimer;
 /// bus also carry 1 kHz, `Config::ROBOT.at_rate(TickRate::MCU_1_KHZ)`).
 const CONFIG: Config = Config::ROBOT;
 
+/// The bus key, from `ROBOT_KEY_HEX` (32 hexadecimal digits) at build time; the public test
+/// key when it is unset. Not yet persisted or provisioned on the part itself: see
+/// `docs/mcu.md`, "Keys and epochs".
+fn key() -> protocol::Key {
+    option_env!("ROBOT_KEY_HEX")
+        .and_then(|hex| protocol::Key::from_hex(hex).ok())
+        .unwrap_or(protocol::TEST_KEY)
+}
+
+/// The session epoch of this start. The board does not yet keep its epoch in a backup
+/// register, so every start opens epoch 1 and a recording of an earlier start is fresh again
+/// until it does (see `docs/mcu.md`, "Keys and epochs").
+const BOARD_EPOCH: u32 = 1;
+
 /// Frames taken from the receive FIFO per pass of the loop (the FIFO holds 3).
 const RX_PER_PASS: u32 = 8;
 
@@ -58,7 +72,8 @@ fn main() -> ! {
     else {
         halt()
     };
-    let Ok(mut node) = Node::new(CONFIG) else {
+    let session = protocol::Session::owned(key(), protocol::Epoch::new(BOARD_EPOCH));
+    let Ok(mut node) = Node::new(CONFIG, session) else {
         halt()
     };
     let mut now = Tick(0);

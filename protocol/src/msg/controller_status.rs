@@ -3,18 +3,19 @@ use serde::{Deserialize, Serialize};
 use crate::codec::{check_layout, Message};
 use crate::id::MessageId;
 use crate::signal::{scalar, Field};
-use crate::units::{Angle, BodyHeight, ControllerMode, FaultFlags, Tick};
+use crate::units::{Angle, BodyHeight, ControllerMode, FaultFlags, ReleaseToken, Tick};
 
 /// Controller status and telemetry, id `0x400`, controller → anyone listening.
 ///
 /// | byte  | field         | type | meaning                                      |
 /// |-------|---------------|------|----------------------------------------------|
-/// | 4     | `mode`        | u8   | [`ControllerMode`]                            |
-/// | 5–6   | `faults`      | u16  | [`FaultFlags`] bits                           |
-/// | 7–10  | `tick`        | u32  | control tick, 1 tick                          |
-/// | 11–12 | `body_height` | i16  | target height offset, 1e-4 m                  |
-/// | 13–14 | `pitch`       | i16  | torso pitch estimate, 1e-4 rad, + = nose down |
-/// | 15–16 | `roll`        | i16  | torso roll estimate, 1e-4 rad, + = left up    |
+/// | 6     | `mode`        | u8   | [`ControllerMode`]                            |
+/// | 7–8   | `faults`      | u16  | [`FaultFlags`] bits                           |
+/// | 9–12  | `tick`        | u32  | control tick, 1 tick                          |
+/// | 13–14 | `body_height` | i16  | target height offset, 1e-4 m                  |
+/// | 15–16 | `pitch`       | i16  | torso pitch estimate, 1e-4 rad, + = nose down |
+/// | 17–18 | `roll`        | i16  | torso roll estimate, 1e-4 rad, + = left up    |
+/// | 19–20 | `release_token` | u16 | the token a release must echo ([`EStop`](crate::EStop)) |
 #[derive(
     Debug,
     Clone,
@@ -38,6 +39,8 @@ pub struct ControllerStatus {
     pub pitch: Angle,
     /// Torso roll.
     pub roll: Angle,
+    /// The token a release of the present (or next) latch must echo.
+    pub release_token: ReleaseToken,
 }
 
 impl Message for ControllerStatus {
@@ -51,6 +54,7 @@ impl Message for ControllerStatus {
         scalar::<BodyHeight>("body_height"),
         scalar::<Angle>("pitch"),
         scalar::<Angle>("roll"),
+        scalar::<ReleaseToken>("release_token"),
     ];
     fn id(_: ()) -> MessageId {
         MessageId::ControllerStatus

@@ -10,9 +10,9 @@ use crate::units::{Count, DriveFlags};
 ///
 /// | byte | field      | type | meaning                                        |
 /// |------|------------|------|------------------------------------------------|
-/// | 4    | `flags`    | u8   | [`DriveFlags`]: enabled, timed out, fault, estop |
-/// | 5–6  | `rejected` | u16  | frames this drive rejected, wraps              |
-/// | 7–8  | `commands` | u16  | valid commands this drive accepted, wraps      |
+/// | 6    | `flags`    | u8   | [`DriveFlags`]: enabled, timed out, fault, estop |
+/// | 7–8  | `rejected` | u16  | frames this drive rejected, wraps              |
+/// | 9–10  | `commands` | u16  | valid commands this drive accepted, wraps      |
 #[derive(
     Debug,
     Clone,

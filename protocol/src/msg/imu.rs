@@ -9,9 +9,9 @@ use crate::units::{Acceleration, AngularRate, QuatComponent};
 ///
 /// | byte  | field          | type    | meaning                                            |
 /// |-------|----------------|---------|----------------------------------------------------|
-/// | 4–11  | `orientation`  | 4 × i16 | quaternion w, x, y, z (world ← body); 1e-4, ±1      |
-/// | 12–17 | `angular_rate` | 3 × i16 | gyro x, y, z; 1e-3 rad/s                            |
-/// | 18–23 | `acceleration` | 3 × i16 | accelerometer x, y, z (specific force); 1e-2 m/s²   |
+/// | 6–13  | `orientation`  | 4 × i16 | quaternion w, x, y, z (world ← body); 1e-4, ±1      |
+/// | 14–19 | `angular_rate` | 3 × i16 | gyro x, y, z; 1e-3 rad/s                            |
+/// | 20–25 | `acceleration` | 3 × i16 | accelerometer x, y, z (specific force); 1e-2 m/s²   |
 #[derive(
     Debug,
     Clone,

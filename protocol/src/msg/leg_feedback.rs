@@ -10,9 +10,9 @@ use crate::units::{Angle, JointVelocity, Torque};
 ///
 /// | byte  | field      | type    | meaning                                  |
 /// |-------|------------|---------|------------------------------------------|
-/// | 4–11  | `position` | 4 × i16 | hip1, hip2, knee, ankle; 1e-4 rad        |
-/// | 12–19 | `velocity` | 4 × i16 | same order; 1e-3 rad/s                   |
-/// | 20–27 | `effort`   | 4 × i16 | same order; applied torque, 1e-2 N·m     |
+/// | 6–13  | `position` | 4 × i16 | hip1, hip2, knee, ankle; 1e-4 rad        |
+/// | 14–21 | `velocity` | 4 × i16 | same order; 1e-3 rad/s                   |
+/// | 22–29 | `effort`   | 4 × i16 | same order; applied torque, 1e-2 N·m     |
 #[derive(
     Debug,
     Clone,

@@ -12,8 +12,8 @@ use crate::units::{Angle, DriveEnable};
 ///
 /// | byte   | field      | type     | meaning                                              |
 /// |--------|------------|----------|------------------------------------------------------|
-/// | 4      | `enable`   | u8       | 0 = torque-free, 1 = servo to the targets             |
-/// | 5–36   | `position` | 16 × i16 | joint target, 1e-4 rad, order of [`JOINT_NAMES`]       |
+/// | 6      | `enable`   | u8       | 0 = torque-free, 1 = servo to the targets             |
+/// | 7–38   | `position` | 16 × i16 | joint target, 1e-4 rad, order of [`JOINT_NAMES`]       |
 #[derive(
     Debug,
     Clone,
@@ -39,6 +39,7 @@ impl Message for LegTargets {
         scalar::<DriveEnable>("enable"),
         array::<Angle>("position", &JOINT_NAMES),
     ];
+    const PROTECTION: crate::e2e::Protection = crate::e2e::AUTHENTICATED;
     fn id(_: ()) -> MessageId {
         MessageId::LegTargets
     }

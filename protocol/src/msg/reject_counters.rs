@@ -15,16 +15,19 @@ pub const REJECT_NAMES: [&str; RejectCause::ALL.len()] = [
     RejectCause::Repeated.name(),
     RejectCause::WrongSequence.name(),
     RejectCause::RateLimited.name(),
+    RejectCause::Unauthentic.name(),
+    RejectCause::Session.name(),
+    RejectCause::StaleRelease.name(),
 ];
 
 /// Frames the controller rejected, by cause, id `0x600` (diagnostics), controller → anyone.
 ///
 /// | byte  | field      | type    | meaning                                            |
 /// |-------|------------|---------|----------------------------------------------------|
-/// | 4–17  | `rejected` | 7 × u16 | by [`RejectCause`]: unknown id, wrong length, CRC, out of range, repeated, wrong sequence, rate limited; wraps |
-/// | 18–19 | `lost`     | u16     | frames missing from accepted sequences, wraps      |
+/// | 6–25  | `rejected` | 10 × u16 | by [`RejectCause`]: unknown id, wrong length, CRC, out of range, repeated, wrong sequence, rate limited, unauthentic, session, stale release; wraps |
+/// | 26–27 | `lost`     | u16      | frames missing from accepted sequences, wraps      |
 ///
-/// 20 bytes: exactly a CAN FD length, no padding.
+/// 28 bytes, padded to 32.
 #[derive(
     Debug,
     Clone,
@@ -59,9 +62,10 @@ impl RejectCounters {
         }
     }
 
-    /// Counts `frames` lost frames.
-    pub fn record_lost(&mut self, frames: u16) {
-        self.lost = Count::from_raw(self.lost.raw().wrapping_add(frames)).unwrap_or_default();
+    /// Counts `frames` lost frames (the count wraps at 2^16).
+    pub fn record_lost(&mut self, frames: u32) {
+        let low = (frames & 0xFFFF) as u16;
+        self.lost = Count::from_raw(self.lost.raw().wrapping_add(low)).unwrap_or_default();
     }
 
     /// Rejections over all causes.

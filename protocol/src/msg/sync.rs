@@ -10,7 +10,7 @@ use crate::units::Tick;
 ///
 /// | byte | field  | type | meaning                     |
 /// |------|--------|------|-----------------------------|
-/// | 4–7  | `tick` | u32  | control tick, 1 tick, wraps |
+/// | 6–9  | `tick` | u32  | control tick, 1 tick, wraps |
 #[derive(
     Debug,
     Clone,

@@ -10,9 +10,9 @@ use crate::units::{BodyHeight, SpeedScale, TeleopMode};
 ///
 /// | byte | field         | type | meaning                                            |
 /// |------|---------------|------|----------------------------------------------------|
-/// | 4    | `mode`        | u8   | [`TeleopMode`]: X W S A L K, stand, fold            |
-/// | 5–6  | `body_height` | i16  | offset from nominal height, 1e-4 m, −0.10…+0.12 m   |
-/// | 7    | `speed_scale` | u8   | 1 %, 0…100                                           |
+/// | 6    | `mode`        | u8   | [`TeleopMode`]: X W S A L K, stand, fold            |
+/// | 7–8  | `body_height` | i16  | offset from nominal height, 1e-4 m, −0.10…+0.12 m   |
+/// | 9    | `speed_scale` | u8   | 1 %, 0…100                                           |
 #[derive(
     Debug,
     Clone,
@@ -41,6 +41,7 @@ impl Message for TeleopCommand {
         scalar::<BodyHeight>("body_height"),
         scalar::<SpeedScale>("speed_scale"),
     ];
+    const PROTECTION: crate::e2e::Protection = crate::e2e::AUTHENTICATED;
     fn id(_: ()) -> MessageId {
         MessageId::TeleopCommand
     }

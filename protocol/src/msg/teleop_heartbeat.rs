@@ -10,7 +10,7 @@ use crate::units::Millis;
 ///
 /// | byte | field    | type | meaning                   |
 /// |------|----------|------|---------------------------|
-/// | 4–7  | `uptime` | u32  | teleop uptime, 1 ms       |
+/// | 6–9  | `uptime` | u32  | teleop uptime, 1 ms       |
 #[derive(
     Debug,
     Clone,
@@ -31,6 +31,7 @@ impl Message for TeleopHeartbeat {
     const NAME: &'static str = "TeleopHeartbeat";
     const DOC: &'static str = "Operator liveness";
     const FIELDS: &'static [Field] = &[scalar::<Millis>("uptime")];
+    const PROTECTION: crate::e2e::Protection = crate::e2e::AUTHENTICATED;
     fn id(_: ()) -> MessageId {
         MessageId::TeleopHeartbeat
     }

@@ -10,7 +10,7 @@ use crate::units::Torque;
 ///
 /// | byte | field    | type    | meaning                            |
 /// |------|----------|---------|------------------------------------|
-/// | 4–7  | `torque` | 2 × i16 | left, right; 1e-2 N·m, + = forward |
+/// | 6–9  | `torque` | 2 × i16 | left, right; 1e-2 N·m, + = forward |
 #[derive(
     Debug,
     Clone,
@@ -31,6 +31,7 @@ impl Message for WheelCommand {
     const NAME: &'static str = "WheelCommand";
     const DOC: &'static str = "Torque of the left and right wheel";
     const FIELDS: &'static [Field] = &[array::<Torque>("torque", &WHEEL_NAMES)];
+    const PROTECTION: crate::e2e::Protection = crate::e2e::AUTHENTICATED;
     fn id(_: ()) -> MessageId {
         MessageId::WheelCommand
     }

@@ -10,9 +10,9 @@ use crate::units::{Torque, WheelAngle, WheelVelocity};
 ///
 /// | byte  | field      | type    | meaning                                      |
 /// |-------|------------|---------|----------------------------------------------|
-/// | 4–7   | `position` | 2 × i16 | left, right; wrapped to ±π, 1e-4 rad         |
-/// | 8–11  | `velocity` | 2 × i16 | left, right; 1e-2 rad/s, + = forward         |
-/// | 12–15 | `effort`   | 2 × i16 | left, right; applied torque, 1e-2 N·m        |
+/// | 6–9   | `position` | 2 × i16 | left, right; wrapped to ±π, 1e-4 rad         |
+/// | 10–13  | `velocity` | 2 × i16 | left, right; 1e-2 rad/s, + = forward         |
+/// | 14–17 | `effort`   | 2 × i16 | left, right; applied torque, 1e-2 N·m        |
 #[derive(
     Debug,
     Clone,

@@ -25,6 +25,9 @@ raw_strategy!(speed, SpeedScale, u8);
 raw_strategy!(tick, Tick, u32);
 raw_strategy!(millis, Millis, u32);
 raw_strategy!(count, Count, u16);
+raw_strategy!(token, ReleaseToken, u16);
+raw_strategy!(epoch, Epoch, u32);
+raw_strategy!(version, WireVersion, u8);
 
 fn pick<T: Copy + core::fmt::Debug + 'static>(all: &'static [T]) -> impl Strategy<Value = T> {
     proptest::sample::select(all)
@@ -32,9 +35,16 @@ fn pick<T: Copy + core::fmt::Debug + 'static>(all: &'static [T]) -> impl Strateg
 
 pub fn any_message() -> impl Strategy<Value = AnyMessage> {
     prop_oneof![
-        (pick(EStopAction::ALL), pick(&NodeId::ALL))
-            .prop_map(|(action, source)| AnyMessage::EStop(EStop { action, source })),
+        (pick(EStopAction::ALL), pick(&NodeId::ALL), token()).prop_map(
+            |(action, source, token)| AnyMessage::EStop(EStop {
+                action,
+                source,
+                token
+            })
+        ),
         tick().prop_map(|tick| AnyMessage::Sync(Sync { tick })),
+        (version(), epoch())
+            .prop_map(|(version, epoch)| AnyMessage::Announce(Announce { version, epoch })),
         (pick(DriveEnable::ALL), proptest::array::uniform16(angle())).prop_map(
             |(enable, position)| AnyMessage::LegTargets(LegTargets {
                 enable,
@@ -95,18 +105,22 @@ pub fn any_message() -> impl Strategy<Value = AnyMessage> {
             tick(),
             height(),
             angle(),
-            angle()
+            angle(),
+            token()
         )
-            .prop_map(|(mode, faults, tick, body_height, pitch, roll)| {
-                AnyMessage::ControllerStatus(ControllerStatus {
-                    mode,
-                    faults: FaultFlags::from_bits(faults).unwrap(),
-                    tick,
-                    body_height,
-                    pitch,
-                    roll,
-                })
-            }),
+            .prop_map(
+                |(mode, faults, tick, body_height, pitch, roll, release_token)| {
+                    AnyMessage::ControllerStatus(ControllerStatus {
+                        mode,
+                        faults: FaultFlags::from_bits(faults).unwrap(),
+                        tick,
+                        body_height,
+                        pitch,
+                        roll,
+                        release_token,
+                    })
+                }
+            ),
         (pick(&Drive::ALL), 0..=DriveFlags::KNOWN, count(), count()).prop_map(
             |(drive, flags, rejected, commands)| {
                 AnyMessage::DriveStatus(
@@ -119,8 +133,33 @@ pub fn any_message() -> impl Strategy<Value = AnyMessage> {
                 )
             }
         ),
-        (proptest::array::uniform7(count()), count()).prop_map(|(rejected, lost)| {
+        (proptest::array::uniform10(count()), count()).prop_map(|(rejected, lost)| {
             AnyMessage::RejectCounters(RejectCounters { rejected, lost })
         }),
     ]
+}
+
+/// The epoch of the tests' controller.
+pub const EPOCH: Epoch = Epoch::new(41);
+
+/// The session the tests' controller owns.
+pub fn controller_session() -> Session {
+    Session::owned(TEST_KEY, EPOCH)
+}
+
+/// The controller's announcement of `epoch` in version `version`, sealed with announcement
+/// counter `counter`.
+pub fn announce_frame(version: WireVersion, epoch: Epoch, counter: u32) -> Frame {
+    AnyMessage::Announce(Announce { version, epoch })
+        .encode(&Session::owned(TEST_KEY, epoch), counter)
+        .unwrap()
+}
+
+/// A member receiver that heard the announcement of `epoch` (counter 0) and joined.
+pub fn joined_member(epoch: Epoch) -> Receiver {
+    let mut member = Receiver::member(TEST_KEY);
+    let frame = announce_frame(WireVersion::THIS, epoch, 0);
+    member.receive(frame.id(), frame.data()).unwrap();
+    assert_eq!(member.session().epoch(), Some(epoch));
+    member
 }

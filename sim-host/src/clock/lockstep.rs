@@ -42,7 +42,7 @@ pub fn run(
     let started = Instant::now();
     let mut stats = RunStats::default();
     for _ in 0..options.cycles {
-        cycle(
+        let advanced = cycle(
             sim,
             bus,
             recorder,
@@ -50,6 +50,9 @@ pub fn run(
             options.reply_timeout,
             &mut peers,
         )?;
+        if !advanced {
+            continue;
+        }
         recorder.row(sim.telemetry())?;
         if !observe(sim, &stats) {
             break;
@@ -68,7 +71,9 @@ pub fn run(
 
 /// One lockstep cycle: feedback and SYNC out, `peers(cycle)`, the controller's commands in
 /// (waiting up to `reply_timeout` for its WheelCommand), one physics step. Counts into `stats`;
-/// the caller records the telemetry row.
+/// the caller records the telemetry row. Returns whether the physics stepped: until the
+/// simulator's nodes have joined the controller's session (heard its announcement) they send
+/// nothing and time stands still.
 pub fn cycle(
     sim: &mut Simulator,
     bus: &mut dyn Bus,
@@ -76,12 +81,13 @@ pub fn cycle(
     stats: &mut RunStats,
     reply_timeout: Duration,
     peers: &mut impl FnMut(u32) -> Result<(), RunError>,
-) -> Result<(), RunError> {
+) -> Result<bool, RunError> {
     let time_s = sim.time_s();
+    let joined = sim.joined();
     // Feedback first, then SYNC: a controller in another process computes the tick when
     // SYNC arrives, with this cycle's feedback already in hand.
     let mut outgoing = sim.frames_due()?;
-    outgoing.push(sim.sync_frame()?);
+    outgoing.extend(sim.sync_frame()?);
     for frame in &outgoing {
         bus.send(frame)?;
         recorder.frame(time_s, frame)?;
@@ -106,6 +112,9 @@ pub fn cycle(
             None => break,
         }
     }
+    if !joined {
+        return Ok(false);
+    }
     if !commanded {
         stats.missed_cycles += 1;
     }
@@ -116,5 +125,5 @@ pub fn cycle(
             time_s: sim.time_s(),
         });
     }
-    Ok(())
+    Ok(true)
 }

@@ -3,7 +3,7 @@
 use std::path::Path;
 
 use host_can::fault_plan::{feedback_nodes, FaultPlan, Faults};
-use protocol::{AnyMessage, EStop, EStopAction, FaultFlags, MessageId, NodeId, RejectCause};
+use protocol::{AnyMessage, EStop, FaultFlags, MessageId, NodeId, RejectCause, Session, TEST_KEY};
 
 use firmware::control::fsm::State;
 
@@ -287,20 +287,15 @@ pub(super) fn estop(model: &Path, from: NodeId) -> Result<CellResult, SessionErr
     let mut rig = clean_until(model, Motion::Trot, latch_s)?;
     // A teleop counts its E-stops; `cansend` sends a fixed frame (counter 0), every time.
     let counter = if from == NodeId::Teleop { 1 } else { 0 };
-    let latch = AnyMessage::EStop(EStop {
-        action: EStopAction::Latch,
-        source: from,
-    })
-    .encode(counter)
-    .map_err(RunError::from)?;
+    let latch = AnyMessage::EStop(EStop::latch(from))
+        .encode(&Session::unjoined(TEST_KEY), counter)
+        .map_err(RunError::from)?;
     rig.tool_send(&latch)?;
     rig.run_until(clear_s)?;
-    let clear = AnyMessage::EStop(EStop {
-        action: EStopAction::Clear,
-        source: from,
-    })
-    .encode(counter + 1)
-    .map_err(RunError::from)?;
+    // A release needs the key and the controller's token: a keyholder's tool or teleop.
+    let clear = rig
+        .release_frame(from)
+        .ok_or(RunError::Encode(protocol::EncodeError::NoSession))?;
     rig.tool_send(&clear)?;
     rig.run_until(clear_s + 1.5)?;
     // Records strictly after the latch was sent (the one at `latch_s` closed the cycle before).

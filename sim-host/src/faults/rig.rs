@@ -12,7 +12,9 @@ use host_can::bus::Bus;
 use host_can::fault_plan::Faults;
 use host_can::faulty_bus::{FaultStats, FaultyBus};
 use host_can::inproc_bus::{InprocBus, InprocEndpoint};
-use protocol::{FaultFlags, Frame, Joints, PerDrive, RejectCause, RejectCounters};
+use protocol::{
+    Epoch, FaultFlags, Frame, Joints, PerDrive, RejectCause, RejectCounters, Session, TEST_KEY,
+};
 use teleop_core::scripted::{PlanStep, ScriptedTeleop};
 
 use crate::clock::lockstep;
@@ -29,6 +31,8 @@ use crate::session::{firmware_config, SessionError};
 pub const RIG_HZ: u32 = 250;
 /// One control period, µs.
 pub const PERIOD_US: u64 = 1_000_000 / RIG_HZ as u64;
+/// The rig's controller session (a rig is its own bus: no earlier session shares it).
+pub const RIG_EPOCH: Epoch = Epoch::new(1);
 
 /// One cycle of a rig run.
 #[derive(Debug, Clone, PartialEq)]
@@ -101,9 +105,10 @@ impl Rig {
         let bus = InprocBus::new();
         let sim_bus = FaultyBus::new(bus.endpoint(), faults);
         let firmware = firmware_config(RIG_HZ).ok_or(SessionError::ControlRate(RIG_HZ))?;
-        let controller =
-            InprocController::new(firmware, bus.endpoint()).map_err(SessionError::Firmware)?;
-        let teleop_bus = FaultyBus::new(bus.transmitter(), teleop_faults);
+        let session = Session::owned(TEST_KEY, RIG_EPOCH);
+        let controller = InprocController::new(firmware, bus.endpoint(), session)
+            .map_err(SessionError::Firmware)?;
+        let teleop_bus = FaultyBus::new(bus.endpoint(), teleop_faults);
         let tool = bus.transmitter();
         Ok(Self {
             model: model.to_owned(),
@@ -122,6 +127,15 @@ impl Rig {
         })
     }
 
+    /// A release of the controller's present latch from `from`, sealed with the key as a
+    /// keyholder's tool (`cargo xtask frame`) would; `None` once the controller is gone.
+    pub fn release_frame(&self, from: protocol::NodeId) -> Option<Frame> {
+        let node = self.controller.as_ref()?.node();
+        let release =
+            protocol::AnyMessage::EStop(protocol::EStop::release(from, node.release_token()));
+        release.encode(node.session(), 1).ok()
+    }
+
     /// Runs one control cycle.
     pub fn step(&mut self) -> Result<(), RunError> {
         let missed_before = self.stats.missed_cycles;
@@ -130,6 +144,9 @@ impl Rig {
         let teleop_bus = &mut self.teleop_bus;
         let controller = &mut self.controller;
         let mut peers = |_cycle: u32| -> Result<(), RunError> {
+            while let Some(frame) = teleop_bus.recv(Duration::ZERO)? {
+                teleop.observe(&frame);
+            }
             for frame in teleop.frames(now_us)? {
                 teleop_bus.send(&frame)?;
             }

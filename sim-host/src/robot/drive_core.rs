@@ -3,8 +3,10 @@
 //! status frame.
 
 use protocol::{
-    AnyMessage, Count, DriveFlags, DriveStatus, E2eCounter, EStopAction, Frame, MessageId, Receiver,
+    AnyMessage, Count, DriveFlags, DriveStatus, EStopAction, EncodeError, Frame, Key, MessageId,
 };
+
+use crate::robot::link::NodeLink;
 
 /// Drive command timeout, as moteus' default: no valid command for this long → torque off.
 pub const COMMAND_TIMEOUT_US: u64 = 100_000;
@@ -22,27 +24,26 @@ pub enum Authority {
 #[derive(Debug, Clone)]
 pub struct DriveCore {
     listens_to: MessageId,
-    receiver: Receiver,
+    link: NodeLink,
     last_command_us: Option<u64>,
     commanded_enable: bool,
     estop: bool,
     rejected: u32,
     commands: u32,
-    status_counter: E2eCounter,
 }
 
 impl DriveCore {
-    /// A drive that takes its commands on `listens_to` (and E-stops).
-    pub fn new(listens_to: MessageId) -> Self {
+    /// A drive that takes its commands on `listens_to` (and E-stops and the controller's
+    /// announcement), in the sessions it joins with `key`.
+    pub fn new(listens_to: MessageId, key: Key) -> Self {
         Self {
             listens_to,
-            receiver: Receiver::default(),
+            link: NodeLink::new(key),
             last_command_us: None,
             commanded_enable: false,
             estop: false,
             rejected: 0,
             commands: 0,
-            status_counter: E2eCounter::default(),
         }
     }
 
@@ -51,15 +52,17 @@ impl DriveCore {
     /// rejected frame is counted and never returned.
     pub fn on_frame(&mut self, now_us: u64, frame: &Frame) -> Option<AnyMessage> {
         let id = frame.id();
-        if id != MessageId::EStop.raw() && id != self.listens_to.raw() {
+        let filter = [MessageId::EStop, MessageId::Announce, self.listens_to];
+        if !filter.iter().any(|listened| listened.raw() == id) {
             return None;
         }
-        match self.receiver.receive(id, frame.data()) {
+        match self.link.receive(id, frame.data()) {
             Ok(accepted) => match accepted.message {
                 AnyMessage::EStop(estop) => {
                     self.estop = estop.action == EStopAction::Latch;
                     None
                 }
+                AnyMessage::Announce(_) => None,
                 message => {
                     self.last_command_us = Some(now_us);
                     self.commands = self.commands.wrapping_add(1);
@@ -112,8 +115,13 @@ impl DriveCore {
         self.estop
     }
 
-    /// The status message (flags and counters) and its rolling counter.
-    pub fn status(&mut self, now_us: u64) -> (DriveStatus, u16) {
+    /// Seals one of this drive's frames in its session (`None` before it has joined one).
+    pub fn seal(&mut self, message: &AnyMessage) -> Result<Option<Frame>, EncodeError> {
+        self.link.seal(message)
+    }
+
+    /// The status message: flags and counters.
+    pub fn status(&self, now_us: u64) -> DriveStatus {
         let mut flags = DriveFlags::EMPTY;
         if self.authority(now_us) == Authority::Drive {
             flags = flags.with(DriveFlags::ENABLED);
@@ -125,13 +133,10 @@ impl DriveCore {
             flags = flags.with(DriveFlags::ESTOP);
         }
         let wrap = |n: u32| Count::from_raw((n & 0xFFFF) as u16).unwrap_or(Count::ZERO);
-        (
-            DriveStatus {
-                flags,
-                rejected: wrap(self.rejected),
-                commands: wrap(self.commands),
-            },
-            self.status_counter.advance(),
-        )
+        DriveStatus {
+            flags,
+            rejected: wrap(self.rejected),
+            commands: wrap(self.commands),
+        }
     }
 }

@@ -7,7 +7,8 @@
 
 use protocol::busload::SCHEDULE;
 use protocol::{
-    decode_frame, AnyMessage, ControllerMode, Drive, EncodeError, Frame, Joints, Leg, MessageId,
+    decode_frame, AnyMessage, ControllerMode, Drive, EncodeError, Frame, Joints, Key, Leg,
+    MessageId,
 };
 
 use crate::robot::imu::{ImuNode, ImuNoise};
@@ -27,12 +28,18 @@ pub struct Hardware {
 
 impl Hardware {
     /// The nodes, sending on the schedule of a controller running at `control_hz`; each leg
-    /// drive enforces its joints' `leg_range_rad`.
-    pub fn new(control_hz: u32, imu_noise: ImuNoise, leg_range_rad: &Joints<[f64; 2]>) -> Self {
+    /// drive enforces its joints' `leg_range_rad`; every node joins the sessions it hears with
+    /// `key`.
+    pub fn new(
+        control_hz: u32,
+        imu_noise: ImuNoise,
+        leg_range_rad: &Joints<[f64; 2]>,
+        key: Key,
+    ) -> Self {
         Self {
-            legs: Leg::ALL.map(|leg| LegDrive::new(leg, *leg_range_rad.leg(leg))),
-            wheel: WheelDrive::default(),
-            imu: ImuNode::new(imu_noise),
+            legs: Leg::ALL.map(|leg| LegDrive::new(leg, *leg_range_rad.leg(leg), key)),
+            wheel: WheelDrive::new(key),
+            imu: ImuNode::new(imu_noise, key),
             control_hz,
             controller_mode: None,
         }
@@ -74,6 +81,7 @@ impl Hardware {
             leg.on_frame(now_us, frame);
         }
         self.wheel.on_frame(now_us, frame);
+        self.imu.on_frame(frame);
         if frame.id() == MessageId::ControllerStatus.raw() {
             if let Ok(decoded) = decode_frame(frame.id(), frame.data()) {
                 if let AnyMessage::ControllerStatus(status) = decoded.message {
@@ -108,27 +116,32 @@ impl Hardware {
             .iter()
             .filter(|s| s.sends_in(cycle, self.control_hz))
         {
-            let (message, counter) = match slot.id {
+            let sealed = match slot.id {
                 MessageId::LegFeedback(leg) => {
                     let drive = &mut self.legs[leg as usize];
-                    (drive.feedback(physics), drive.next_feedback_counter())
+                    let message = drive.feedback(physics);
+                    drive.core_mut().seal(&message)?
                 }
-                MessageId::WheelFeedback => (
-                    self.wheel.feedback(physics),
-                    self.wheel.next_feedback_counter(),
-                ),
-                MessageId::Imu => self.imu.sample(physics),
+                MessageId::WheelFeedback => {
+                    let message = self.wheel.feedback(physics);
+                    self.wheel.core_mut().seal(&message)?
+                }
+                MessageId::Imu => {
+                    let message = self.imu.sample(physics);
+                    self.imu.seal(&message)?
+                }
                 MessageId::DriveStatus(drive) => {
                     let core = match drive {
                         Drive::Wheel => self.wheel.core_mut(),
                         leg => self.legs[leg as usize].core_mut(),
                     };
-                    let (status, counter) = core.status(now_us);
-                    (AnyMessage::DriveStatus(drive, status), counter)
+                    let message = AnyMessage::DriveStatus(drive, core.status(now_us));
+                    core.seal(&message)?
                 }
                 _ => continue,
             };
-            frames.push(message.encode(counter)?);
+            // A node that has not heard the controller's announcement yet sends nothing.
+            frames.extend(sealed);
         }
         Ok(frames)
     }

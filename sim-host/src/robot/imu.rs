@@ -5,7 +5,11 @@ use rand::rngs::SmallRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
-use protocol::{Acceleration, AngularRate, AnyMessage, E2eCounter, Imu, QuatComponent};
+use protocol::{
+    Acceleration, AngularRate, AnyMessage, EncodeError, Frame, Imu, Key, MessageId, QuatComponent,
+};
+
+use crate::robot::link::NodeLink;
 
 use crate::robot::physics::Physics;
 
@@ -31,17 +35,30 @@ pub struct ImuNoise {
 pub struct ImuNode {
     noise: ImuNoise,
     rng: SmallRng,
-    counter: E2eCounter,
+    link: NodeLink,
 }
 
 impl ImuNode {
-    /// An IMU with `noise`.
-    pub fn new(noise: ImuNoise) -> Self {
+    /// An IMU with `noise` that joins the sessions it hears with `key`.
+    pub fn new(noise: ImuNoise, key: Key) -> Self {
         Self {
             noise,
             rng: SmallRng::seed_from_u64(noise.seed),
-            counter: E2eCounter::default(),
+            link: NodeLink::new(key),
         }
+    }
+
+    /// Takes a frame from the bus: the IMU listens to the controller's announcement only.
+    pub fn on_frame(&mut self, frame: &Frame) {
+        if frame.id() == MessageId::Announce.raw() {
+            // A refused announcement is counted by the link; the IMU has nothing else to do.
+            let _ = self.link.receive(frame.id(), frame.data());
+        }
+    }
+
+    /// Seals a sample in the IMU's session (`None` before it has joined one).
+    pub fn seal(&mut self, message: &AnyMessage) -> Result<Option<Frame>, EncodeError> {
+        self.link.seal(message)
     }
 
     fn gaussian(&mut self, std: f64) -> f64 {
@@ -52,8 +69,8 @@ impl ImuNode {
         }
     }
 
-    /// One sample of the current state, and its rolling counter.
-    pub fn sample(&mut self, physics: &Physics) -> (AnyMessage, u16) {
+    /// One sample of the current state.
+    pub fn sample(&mut self, physics: &Physics) -> AnyMessage {
         let (quat, gyro, accel) = physics.imu();
         let n = self.noise;
         let mut rotation = [0.0; 3];
@@ -74,7 +91,7 @@ impl ImuNode {
             angular_rate: rate.map(|r| AngularRate::saturating_from_si(r as f32)),
             acceleration: force.map(|a| Acceleration::saturating_from_si(a as f32)),
         });
-        (message, self.counter.advance())
+        message
     }
 }
 

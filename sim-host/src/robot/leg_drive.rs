@@ -7,8 +7,8 @@
 //! command counted ([`LegDrive::clamped`]).
 
 use protocol::{
-    Angle, AnyMessage, DriveEnable, E2eCounter, Frame, JointVelocity, Joints, Leg, LegFeedback,
-    MessageId, Torque,
+    Angle, AnyMessage, DriveEnable, Frame, JointVelocity, Joints, Leg, LegFeedback, MessageId,
+    Torque,
 };
 
 use crate::robot::drive_core::{Authority, DriveCore};
@@ -22,7 +22,6 @@ pub struct LegDrive {
     range_rad: [[f64; 2]; 4],
     targets_rad: [f64; 4],
     clamped: u64,
-    feedback_counter: E2eCounter,
 }
 
 impl LegDrive {
@@ -30,15 +29,14 @@ impl LegDrive {
     /// `range_rad` ([low, high] each). The drive keeps its limits as the wire does, in counts of
     /// the `Angle` field (1e-4 rad), so that a target the controller put exactly on a limit is
     /// not clamped by the field's rounding.
-    pub fn new(leg: Leg, range_rad: [[f64; 2]; 4]) -> Self {
+    pub fn new(leg: Leg, range_rad: [[f64; 2]; 4], key: protocol::Key) -> Self {
         let in_counts = |rad: f64| f64::from(Angle::saturating_from_si(rad as f32).si());
         Self {
             leg,
-            core: DriveCore::new(MessageId::LegTargets),
+            core: DriveCore::new(MessageId::LegTargets, key),
             range_rad: range_rad.map(|[low, high]| [in_counts(low), in_counts(high)]),
             targets_rad: [0.0; 4],
             clamped: 0,
-            feedback_counter: E2eCounter::default(),
         }
     }
 
@@ -113,10 +111,5 @@ impl LegDrive {
                 effort: efforts.map(Torque::saturating_from_si),
             },
         )
-    }
-
-    /// The rolling counter for the next feedback frame.
-    pub fn next_feedback_counter(&mut self) -> u16 {
-        self.feedback_counter.advance()
     }
 }

@@ -6,6 +6,7 @@ pub mod drive_core;
 pub mod hardware;
 pub mod imu;
 pub mod leg_drive;
+pub mod link;
 pub mod model;
 pub mod physics;
 pub mod wheel_drive;

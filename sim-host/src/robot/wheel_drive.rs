@@ -4,9 +4,7 @@
 //! Like a real drive it enforces its rating whatever the wire says: a torque above
 //! [`WHEEL_PEAK_TORQUE_NM`] is clamped to it and the command counted ([`WheelDrive::clamped`]).
 
-use protocol::{
-    AnyMessage, E2eCounter, Frame, MessageId, Torque, WheelAngle, WheelFeedback, WheelVelocity,
-};
+use protocol::{AnyMessage, Frame, MessageId, Torque, WheelAngle, WheelFeedback, WheelVelocity};
 
 use crate::robot::drive_core::{Authority, DriveCore};
 use crate::robot::physics::Physics;
@@ -22,16 +20,15 @@ pub struct WheelDrive {
     core: DriveCore,
     torque_nm: [f64; 2],
     clamped: u64,
-    feedback_counter: E2eCounter,
 }
 
-impl Default for WheelDrive {
-    fn default() -> Self {
+impl WheelDrive {
+    /// A wheel drive that joins the sessions it hears with `key`.
+    pub fn new(key: protocol::Key) -> Self {
         Self {
-            core: DriveCore::new(MessageId::WheelCommand),
+            core: DriveCore::new(MessageId::WheelCommand, key),
             torque_nm: [0.0; 2],
             clamped: 0,
-            feedback_counter: E2eCounter::default(),
         }
     }
 }
@@ -92,10 +89,5 @@ impl WheelDrive {
                 .wheel_efforts_nm()
                 .map(|t| Torque::saturating_from_si(t as f32)),
         })
-    }
-
-    /// The rolling counter for the next feedback frame.
-    pub fn next_feedback_counter(&mut self) -> u16 {
-        self.feedback_counter.advance()
     }
 }

@@ -31,10 +31,14 @@ pub struct InprocController {
 }
 
 impl InprocController {
-    /// The firmware with `config` on `bus`.
-    pub fn new(config: Config, bus: InprocEndpoint) -> Result<Self, ConfigError> {
+    /// The firmware with `config` on `bus`, opening `session`.
+    pub fn new(
+        config: Config,
+        bus: InprocEndpoint,
+        session: protocol::Session,
+    ) -> Result<Self, ConfigError> {
         Ok(Self {
-            node: Node::new(config)?,
+            node: Node::new(config, session)?,
             bus,
             tick: Tick(0),
             rejected: 0,

@@ -8,6 +8,7 @@ use host_can::bus::Bus;
 use host_can::inproc_bus::InprocBus;
 use host_can::socketcan_bus::SocketCanBus;
 use protocol::RejectCause;
+use protocol::{Epoch, Session, TEST_KEY};
 use teleop_core::scripted::ScriptedTeleop;
 
 use crate::session::config::{firmware_config, BusChoice, SessionConfig};
@@ -41,10 +42,11 @@ impl Nodes {
                     .map_or_else(InprocBus::new, |a| a.bus.clone());
                 let firmware = firmware_config(config.control_hz)
                     .ok_or(SessionError::ControlRate(config.control_hz))?;
-                let controller = InprocController::new(firmware, bus.endpoint())
+                let session = Session::owned(TEST_KEY, epoch_now());
+                let controller = InprocController::new(firmware, bus.endpoint(), session)
                     .map_err(SessionError::Firmware)?;
                 let teleop: Option<Box<dyn Bus>> = if has_teleop {
-                    Some(Box::new(bus.transmitter()))
+                    Some(Box::new(bus.endpoint()))
                 } else {
                     None
                 };
@@ -70,6 +72,20 @@ impl Nodes {
     }
 }
 
+/// Most frames the scripted operator takes from its bus per cycle.
+const TELEOP_RX_LIMIT: usize = 4_096;
+
+/// An epoch for an in-process controller: seconds since 2020-01-01 UTC, so that it grows from
+/// run to run as a persisted one does on a robot (every simulated run opens a session no
+/// recording of an earlier run belongs to).
+pub fn epoch_now() -> Epoch {
+    const SINCE_2020_S: u64 = 1_577_836_800;
+    let now_s = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    Epoch::new(u32::try_from(now_s.saturating_sub(SINCE_2020_S)).unwrap_or(u32::MAX))
+}
+
 /// The nodes beside the simulator, run once per cycle: the operator sends what its plan says
 /// for the cycle's time, then the firmware services its bus.
 pub(crate) struct Peers {
@@ -84,6 +100,14 @@ impl Peers {
     /// One cycle of the peers.
     pub(crate) fn cycle(&mut self, cycle: u32) -> Result<(), RunError> {
         if let Some(bus) = &mut self.teleop_bus {
+            // The operator hears the controller's announcement and status (bounded: a flooded
+            // bus leaves the rest for the next cycle).
+            for _ in 0..TELEOP_RX_LIMIT {
+                let Some(frame) = bus.recv(std::time::Duration::ZERO)? else {
+                    break;
+                };
+                self.teleop.observe(&frame);
+            }
             for frame in self.teleop.frames(u64::from(cycle) * self.period_us)? {
                 bus.send(&frame)?;
             }

@@ -4,7 +4,9 @@
 
 use std::path::Path;
 
-use protocol::{AnyMessage, E2eCounter, EncodeError, Frame, Joints, Sync, Tick};
+use protocol::{AnyMessage, EncodeError, Frame, Joints, Key, MessageId, Sync, Tick, TEST_KEY};
+
+use crate::robot::link::NodeLink;
 
 use crate::output::telemetry::TelemetryRow;
 use crate::robot::hardware::Hardware;
@@ -51,17 +53,30 @@ pub struct Simulator {
     cycle_us: u64,
     cycle: u32,
     now_us: u64,
-    sync_counter: E2eCounter,
+    /// The simulator's clock as a bus node: it sends SYNC in the controller's session.
+    clock: NodeLink,
 }
 
 impl Simulator {
     /// Loads `model`, places the robot at `start` and sets the nodes up for a controller at
-    /// `control_hz`. The model's timestep must divide the control period.
+    /// `control_hz`, with the simulation's test key. The model's timestep must divide the
+    /// control period.
     pub fn new(
         model: &Path,
         control_hz: u32,
         start: StartPose,
         imu_noise: ImuNoise,
+    ) -> Result<Self, ModelError> {
+        Self::with_key(model, control_hz, start, imu_noise, TEST_KEY)
+    }
+
+    /// As [`Simulator::new`], every node joining the sessions it hears with `key`.
+    pub fn with_key(
+        model: &Path,
+        control_hz: u32,
+        start: StartPose,
+        imu_noise: ImuNoise,
+        key: Key,
     ) -> Result<Self, ModelError> {
         let mut physics = Physics::load(model)?;
         let timestep_s = physics.timestep_s();
@@ -76,7 +91,7 @@ impl Simulator {
             });
         }
         physics.place(start.height_m, &start.leg_joint_rad);
-        let hardware = Hardware::new(control_hz, imu_noise, &physics.layout().leg_range_rad);
+        let hardware = Hardware::new(control_hz, imu_noise, &physics.layout().leg_range_rad, key);
         Ok(Self {
             physics,
             hardware,
@@ -84,7 +99,7 @@ impl Simulator {
             cycle_us: (period_s * 1e6).round() as u64,
             cycle: 0,
             now_us: 0,
-            sync_counter: E2eCounter::default(),
+            clock: NodeLink::new(key),
         })
     }
 
@@ -116,14 +131,25 @@ impl Simulator {
     /// Hands a received frame to the nodes.
     pub fn receive(&mut self, frame: &Frame) {
         self.hardware.on_frame(self.now_us, frame);
+        if frame.id() == MessageId::Announce.raw() {
+            // A refused announcement is counted by the clock's link; nothing else to do.
+            let _ = self.clock.receive(frame.id(), frame.data());
+        }
     }
 
-    /// The lockstep SYNC frame of this cycle: the tick the controller should compute.
-    pub fn sync_frame(&mut self) -> Result<Frame, EncodeError> {
-        AnyMessage::Sync(Sync {
+    /// Whether the simulator's clock has joined the controller's session: in lockstep, no
+    /// SYNC goes out before (the controller announces its session at start).
+    pub fn joined(&self) -> bool {
+        self.clock.joined()
+    }
+
+    /// The lockstep SYNC frame of this cycle: the tick the controller should compute; `None`
+    /// before the controller's session is joined.
+    pub fn sync_frame(&mut self) -> Result<Option<Frame>, EncodeError> {
+        let sync = AnyMessage::Sync(Sync {
             tick: Tick::from_raw(self.cycle).unwrap_or(Tick::saturating_from_si(0.0)),
-        })
-        .encode(self.sync_counter.advance())
+        });
+        self.clock.seal(&sync)
     }
 
     /// The frames the nodes send at the start of this cycle (feedback, IMU, status).

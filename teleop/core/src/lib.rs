@@ -6,6 +6,7 @@
 //!   change and at 50 Hz, the heartbeat at 50 Hz, E-stop latch and clear;
 //! - [`scenario`] and [`scripted`]: a script of commands over time (a TOML file) and the node
 //!   that follows it, for automation and tests;
+//! - [`link`]: the operator's end of the bus session (join, seal, resume);
 //! - [`bus_status`]: what the operator sees of the robot, read off the bus.
 // Functions stay short enough to read whole (clippy.toml: 80 lines); tests may run longer.
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
@@ -14,6 +15,7 @@
 
 pub mod bus_status;
 pub mod keys;
+pub mod link;
 pub mod operator;
 pub mod scenario;
 pub mod scripted;

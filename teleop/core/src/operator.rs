@@ -6,11 +6,12 @@
 //! `R` twice within 2 s, so that no single stray key does it.
 
 use protocol::{
-    AnyMessage, BodyHeight, ControllerMode, E2eCounter, EStop, EStopAction, EncodeError, Frame,
-    Millis, NodeId, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode,
+    AnyMessage, BodyHeight, ControllerMode, EStop, EStopAction, EncodeError, Frame, Millis, NodeId,
+    ReleaseToken, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, TEST_KEY,
 };
 
 use crate::keys::Action;
+use crate::link::OperatorLink;
 
 /// Period of the command and heartbeat, ms (50 Hz).
 pub const PERIOD_MS: u64 = 20;
@@ -46,9 +47,9 @@ pub struct Operator {
     pending_estop: Option<EStopAction>,
     command_changed: bool,
     next_send_ms: u64,
-    command_counter: E2eCounter,
-    heartbeat_counter: E2eCounter,
-    estop_counter: E2eCounter,
+    link: OperatorLink,
+    /// The release token of the controller's last authentic status.
+    release_token: Option<ReleaseToken>,
 }
 
 impl Default for Operator {
@@ -58,8 +59,13 @@ impl Default for Operator {
 }
 
 impl Operator {
-    /// At STOP, nominal height, full speed, no E-stop.
+    /// At STOP, nominal height, full speed, no E-stop, with the simulation's test key.
     pub fn new() -> Self {
+        Self::with_link(OperatorLink::new(TEST_KEY))
+    }
+
+    /// As [`Operator::new`], on `link` (the operator's key and resume point).
+    pub fn with_link(link: OperatorLink) -> Self {
         Self {
             mode: TeleopMode::Stop,
             body_height_m: 0.0,
@@ -71,10 +77,29 @@ impl Operator {
             pending_estop: None,
             command_changed: true,
             next_send_ms: 0,
-            command_counter: E2eCounter::default(),
-            heartbeat_counter: E2eCounter::default(),
-            estop_counter: E2eCounter::default(),
+            link,
+            release_token: None,
         }
+    }
+
+    /// The session link (for its resume point).
+    pub fn link(&self) -> &OperatorLink {
+        &self.link
+    }
+
+    /// Takes a frame heard on the bus: the controller's announcement joins its session; an
+    /// authentic status heard now confirms a latch this operator sent and gives the token a
+    /// release must echo.
+    pub fn observe(&mut self, frame: &Frame) {
+        if let Some(AnyMessage::ControllerStatus(status)) = self.link.observe(frame) {
+            self.release_token = Some(status.release_token);
+            self.observe_controller(status.mode);
+        }
+    }
+
+    /// Whether the controller's session has been joined (commands go out only then).
+    pub fn joined(&self) -> bool {
+        self.link.epoch().is_some()
     }
 
     /// The commanded mode.
@@ -106,7 +131,7 @@ impl Operator {
     /// Takes the controller's reported mode from a status frame just heard: an `EStop` confirms
     /// a latch this operator has sent (a status heard before the latch went out confirms
     /// nothing).
-    pub fn observe_controller(&mut self, mode: ControllerMode) {
+    fn observe_controller(&mut self, mode: ControllerMode) {
         if self.estop_latched && self.latch_sent_ms.is_some() && mode == ControllerMode::EStop {
             self.estop_confirmed = true;
         }
@@ -168,10 +193,11 @@ impl Operator {
         Outcome::Continue
     }
 
-    /// The frames due at `now_ms`: an E-stop latch or clear at once (a latch again every
+    /// The frames due at `now_ms`: an E-stop latch or release at once (a latch again every
     /// [`LATCH_REPEAT_MS`] until the controller confirms it: a lost latch frame must not leave
     /// the robot moving), the command at once when it changed, and the command and heartbeat
-    /// every [`PERIOD_MS`].
+    /// every [`PERIOD_MS`]. Until the controller's session is joined only a latch goes out; a
+    /// release waits for the controller's token.
     pub fn poll(&mut self, now_ms: u64) -> Result<Vec<Frame>, EncodeError> {
         let mut frames = Vec::with_capacity(3);
         let repeat_latch = self.estop_latched
@@ -183,14 +209,21 @@ impl Operator {
             self.pending_estop = Some(EStopAction::Latch);
         }
         if let Some(action) = self.pending_estop.take() {
-            if action == EStopAction::Latch {
-                self.latch_sent_ms = Some(now_ms);
+            let estop = match action {
+                EStopAction::Latch => {
+                    self.latch_sent_ms = Some(now_ms);
+                    Some(EStop::latch(NodeId::Teleop))
+                }
+                EStopAction::Clear => self
+                    .release_token
+                    .map(|token| EStop::release(NodeId::Teleop, token)),
+            };
+            match estop.map(|estop| self.link.seal(&AnyMessage::EStop(estop))) {
+                Some(Ok(Some(frame))) => frames.push(frame),
+                Some(Err(error)) => return Err(error),
+                // Not joined yet, or no token heard: the release waits.
+                Some(Ok(None)) | None => self.pending_estop = Some(action),
             }
-            let estop = AnyMessage::EStop(EStop {
-                action,
-                source: NodeId::Teleop,
-            });
-            frames.push(estop.encode(self.estop_counter.advance())?);
         }
         let periodic = now_ms >= self.next_send_ms;
         if self.command_changed || periodic {
@@ -199,7 +232,7 @@ impl Operator {
                 body_height: BodyHeight::saturating_from_si(self.body_height_m),
                 speed_scale: SpeedScale::saturating_from_si(self.speed_scale_pct),
             });
-            frames.push(command.encode(self.command_counter.advance())?);
+            frames.extend(self.link.seal(&command)?);
             self.command_changed = false;
         }
         if periodic {
@@ -207,7 +240,7 @@ impl Operator {
             let heartbeat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
                 uptime: Millis::from_raw(uptime).unwrap_or(Millis::saturating_from_si(0.0)),
             });
-            frames.push(heartbeat.encode(self.heartbeat_counter.advance())?);
+            frames.extend(self.link.seal(&heartbeat)?);
             self.next_send_ms = now_ms - now_ms % PERIOD_MS + PERIOD_MS;
         }
         Ok(frames)
@@ -218,24 +251,81 @@ impl Operator {
 mod tests {
     use super::*;
     use crate::keys::{action, Key};
-    use protocol::{MessageId, Receiver};
+    use protocol::{
+        Angle, Announce, BodyHeight, ControllerStatus, Epoch, FaultFlags, MessageId, Receiver,
+        Sender, Session, Tick, WireVersion,
+    };
 
-    fn decode(frames: &[Frame], rx: &mut Receiver) -> Vec<AnyMessage> {
-        frames
-            .iter()
-            .map(|f| rx.receive(f.id(), f.data()).unwrap().message)
-            .collect()
+    /// The controller's side of the session, as far as an operator hears and is heard.
+    struct FakeController {
+        session: Session,
+        sender: Sender,
+        rx: Receiver,
+    }
+
+    impl FakeController {
+        fn new() -> Self {
+            let session = Session::owned(TEST_KEY, Epoch::new(7));
+            Self {
+                session,
+                sender: Sender::new(),
+                rx: Receiver::owner(session),
+            }
+        }
+
+        fn announce(&mut self) -> Frame {
+            let announce = AnyMessage::Announce(Announce {
+                version: WireVersion::THIS,
+                epoch: Epoch::new(7),
+            });
+            self.sender.seal(&self.session, &announce).unwrap()
+        }
+
+        fn status(&mut self, mode: ControllerMode) -> Frame {
+            let status = AnyMessage::ControllerStatus(ControllerStatus {
+                mode,
+                faults: FaultFlags::EMPTY,
+                tick: Tick::from_raw(0).unwrap(),
+                body_height: BodyHeight::saturating_from_si(0.0),
+                pitch: Angle::saturating_from_si(0.0),
+                roll: Angle::saturating_from_si(0.0),
+                release_token: ReleaseToken::new(3),
+            });
+            self.sender.seal(&self.session, &status).unwrap()
+        }
+
+        fn decode(&mut self, frames: &[Frame]) -> Vec<AnyMessage> {
+            frames
+                .iter()
+                .map(|f| self.rx.receive(f.id(), f.data()).unwrap().message)
+                .collect()
+        }
+    }
+
+    #[test]
+    fn nothing_but_a_latch_goes_out_before_the_controller_is_heard() {
+        let mut op = Operator::new();
+        assert!(op.poll(0).unwrap().is_empty());
+        op.press(1, Action::EStop);
+        let frames = op.poll(1).unwrap();
+        assert_eq!(frames.len(), 1);
+        assert_eq!(frames[0].id(), MessageId::EStop.raw());
+        let mut ctl = FakeController::new();
+        op.observe(&ctl.announce());
+        assert!(op.joined());
+        assert!(!ctl.decode(&op.poll(20).unwrap()).is_empty());
     }
 
     #[test]
     fn a_key_goes_out_at_once_and_the_command_and_heartbeat_every_20_ms() {
         let mut op = Operator::new();
-        let mut rx = Receiver::default();
-        let first = decode(&op.poll(0).unwrap(), &mut rx);
+        let mut ctl = FakeController::new();
+        op.observe(&ctl.announce());
+        let first = ctl.decode(&op.poll(0).unwrap());
         assert_eq!(first.len(), 2, "command and heartbeat at start: {first:?}");
         assert!(op.poll(5).unwrap().is_empty(), "nothing between periods");
         op.press(7, action(Key::Char('w')).unwrap());
-        let now = decode(&op.poll(7).unwrap(), &mut rx);
+        let now = ctl.decode(&op.poll(7).unwrap());
         assert!(matches!(
             now.as_slice(),
             [AnyMessage::TeleopCommand(TeleopCommand {
@@ -263,11 +353,12 @@ mod tests {
     #[test]
     fn space_latches_at_once_and_only_r_twice_within_2_s_releases() {
         let mut op = Operator::new();
-        let mut rx = Receiver::default();
+        let mut ctl = FakeController::new();
+        op.observe(&ctl.announce());
         op.poll(0).unwrap();
         op.press(1, action(Key::Char('l')).unwrap());
         op.press(2, action(Key::Char(' ')).unwrap());
-        let frames = decode(&op.poll(2).unwrap(), &mut rx);
+        let frames = ctl.decode(&op.poll(2).unwrap());
         assert!(matches!(
             frames.first(),
             Some(AnyMessage::EStop(EStop {
@@ -290,21 +381,28 @@ mod tests {
             op.estop_latched(),
             "a key between the two R disarms the release"
         );
+        op.observe(&ctl.status(ControllerMode::EStop));
         op.press(3_500, Action::Release);
         assert!(!op.estop_latched());
-        let frames = decode(&op.poll(3_500).unwrap(), &mut rx);
-        assert!(matches!(
-            frames.first(),
-            Some(AnyMessage::EStop(EStop {
-                action: EStopAction::Clear,
-                ..
-            }))
-        ));
+        let frames = ctl.decode(&op.poll(3_500).unwrap());
+        assert!(
+            matches!(
+                frames.first(),
+                Some(AnyMessage::EStop(EStop {
+                    action: EStopAction::Clear,
+                    token,
+                    ..
+                })) if token.raw() == 3
+            ),
+            "the release echoes the controller's token: {frames:?}"
+        );
     }
 
     #[test]
     fn the_latch_repeats_until_a_status_heard_after_it_confirms_it() {
         let mut op = Operator::new();
+        let mut ctl = FakeController::new();
+        op.observe(&ctl.announce());
         let latches = |frames: &[Frame]| {
             frames
                 .iter()
@@ -315,18 +413,18 @@ mod tests {
         op.press(10, Action::EStop);
         // A status heard before the latch went out (the controller still in its old E-stop,
         // say) confirms nothing.
-        op.observe_controller(ControllerMode::EStop);
+        op.observe(&ctl.status(ControllerMode::EStop));
         assert!(!op.estop_confirmed());
         assert_eq!(latches(&op.poll(10).unwrap()), 1);
         assert_eq!(latches(&op.poll(12).unwrap()), 0, "not before 4 ms");
         assert_eq!(latches(&op.poll(14).unwrap()), 1, "again after 4 ms");
-        op.observe_controller(ControllerMode::Stop);
+        op.observe(&ctl.status(ControllerMode::Stop));
         assert_eq!(
             latches(&op.poll(18).unwrap()),
             1,
             "another mode confirms nothing"
         );
-        op.observe_controller(ControllerMode::EStop);
+        op.observe(&ctl.status(ControllerMode::EStop));
         assert!(op.estop_confirmed());
         assert_eq!(
             (19..100)

@@ -1,11 +1,19 @@
 //! A teleop node that follows a plan (time → mode) instead of a keyboard: it sends the current
 //! command and a heartbeat at 50 Hz, as the interactive teleop does. Used by `sim-host run
 //! --drive` and by tests.
+//!
+//! The controller starts interlocked (no motion until a STOP, then a motion). A script arms it
+//! on its own once, at its start: it sends STOP until the controller's status shows the
+//! interlock released, then follows its plan — so scenario files need no STOP of their own.
+//! It does not re-arm a controller that restarts or releases an E-stop later in the run: that
+//! takes a STOP step in the plan, as it takes an operator's X.
 
 use protocol::{
-    AnyMessage, BodyHeight, E2eCounter, EncodeError, Frame, Millis, SpeedScale, TeleopCommand,
-    TeleopHeartbeat, TeleopMode,
+    AnyMessage, BodyHeight, EncodeError, FaultFlags, Frame, Millis, SpeedScale, TeleopCommand,
+    TeleopHeartbeat, TeleopMode, TEST_KEY,
 };
+
+use crate::link::OperatorLink;
 
 /// Teleop traffic period, µs (50 Hz).
 pub const PERIOD_US: u64 = 20_000;
@@ -28,20 +36,43 @@ pub struct PlanStep {
 pub struct ScriptedTeleop {
     plan: Vec<PlanStep>,
     next_send_us: u64,
-    command_counter: E2eCounter,
-    heartbeat_counter: E2eCounter,
+    link: OperatorLink,
+    /// Whether a STOP of the arming phase went out.
+    stop_sent: bool,
+    /// Whether the controller has been seen armed after that STOP: the plan is followed.
+    armed: bool,
 }
 
 impl ScriptedTeleop {
-    /// An operator following `plan` (sorted by time here).
-    pub fn new(mut plan: Vec<PlanStep>) -> Self {
+    /// An operator following `plan` (sorted by time here), with the simulation's test key.
+    pub fn new(plan: Vec<PlanStep>) -> Self {
+        Self::with_link(plan, OperatorLink::new(TEST_KEY))
+    }
+
+    /// As [`ScriptedTeleop::new`], on `link`.
+    pub fn with_link(mut plan: Vec<PlanStep>, link: OperatorLink) -> Self {
         plan.sort_by_key(|s| s.at_us);
         Self {
             plan,
             next_send_us: 0,
-            command_counter: E2eCounter::default(),
-            heartbeat_counter: E2eCounter::default(),
+            link,
+            stop_sent: false,
+            armed: false,
         }
+    }
+
+    /// Takes a frame heard on the bus: the controller's announcement and status.
+    pub fn observe(&mut self, frame: &Frame) {
+        if let Some(AnyMessage::ControllerStatus(status)) = self.link.observe(frame) {
+            if self.stop_sent && !status.faults.contains(FaultFlags::AWAITING_STOP) {
+                self.armed = true;
+            }
+        }
+    }
+
+    /// Whether the script has armed the controller and follows its plan.
+    pub fn armed(&self) -> bool {
+        self.armed
     }
 
     /// The step in force at `now_us`.
@@ -57,18 +88,26 @@ impl ScriptedTeleop {
         self.next_send_us = now_us - now_us % PERIOD_US + PERIOD_US;
         let mut frames = Vec::with_capacity(2);
         if let Some(step) = self.current(now_us).copied() {
+            let mode = if self.armed {
+                step.mode
+            } else {
+                TeleopMode::Stop
+            };
             let command = AnyMessage::TeleopCommand(TeleopCommand {
-                mode: step.mode,
+                mode,
                 body_height: BodyHeight::saturating_from_si(step.body_height_m),
                 speed_scale: SpeedScale::saturating_from_si(step.speed_scale_pct),
             });
-            frames.push(command.encode(self.command_counter.advance())?);
+            if let Some(frame) = self.link.seal(&command)? {
+                self.stop_sent |= mode == TeleopMode::Stop;
+                frames.push(frame);
+            }
         }
         let uptime_ms = u32::try_from(now_us / 1000).unwrap_or(u32::MAX);
         let heartbeat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
             uptime: Millis::from_raw(uptime_ms).unwrap_or(Millis::saturating_from_si(0.0)),
         });
-        frames.push(heartbeat.encode(self.heartbeat_counter.advance())?);
+        frames.extend(self.link.seal(&heartbeat)?);
         Ok(frames)
     }
 }

@@ -12,12 +12,20 @@ use protocol::{Frame, MessageId};
 
 use super::Frames;
 
+/// The session of the recorded run.
+fn pil_session() -> protocol::Session {
+    protocol::Session::owned(
+        protocol::TEST_KEY,
+        protocol::Epoch::new(pil_format::PIL_EPOCH),
+    )
+}
+
 /// The host build of the core on the same inputs.
 pub(super) fn host_replay(recording: &Recording) -> Result<Vec<Frames>, String> {
     let rate = TickRate::new(u32::from(recording.control_hz))
         .ok_or_else(|| format!("bad control rate {}", recording.control_hz))?;
-    let mut node =
-        Node::new(Config::ROBOT.at_rate(rate)).map_err(|e| format!("config rejected: {e:?}"))?;
+    let mut node = Node::new(Config::ROBOT.at_rate(rate), pil_session())
+        .map_err(|e| format!("config rejected: {e:?}"))?;
     let mut out = Vec::with_capacity(recording.ticks.len());
     for (k, frames) in recording.ticks.iter().enumerate() {
         let now = Tick(recording.first_tick.wrapping_add(k as u32));

@@ -17,6 +17,7 @@
 //!
 //! The core (header, errors, raw reader) is `no_std` without a heap; the `alloc` feature adds
 //! `Recording`, which reads and writes both formats.
+
 // Functions stay short enough to read whole (clippy.toml: 80 lines); tests may run longer.
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 #![no_std]
@@ -27,6 +28,10 @@
     clippy::panic,
     clippy::indexing_slicing
 )]
+
+/// The session epoch of the recorded run: the recorder, the image and the host replay all
+/// open this session with the test key, so that the recorded frames are fresh to both cores.
+pub const PIL_EPOCH: u32 = 1;
 
 #[cfg(feature = "alloc")]
 extern crate alloc;
