@@ -156,7 +156,14 @@ mod tests {
     use crate::config::Config;
     use core::convert::Infallible;
     use heapless::{Deque, Vec};
-    use protocol::{E2eCounter, Sync};
+    use protocol::{Epoch, Sender, Session, Sync, TEST_KEY};
+
+    /// The session of the node under test; the simulator's SYNC is sealed in it.
+    const SESSION: Session = Session::owned(TEST_KEY, Epoch::new(1));
+
+    fn node() -> Node {
+        Node::new(Config::ROBOT, SESSION).unwrap()
+    }
 
     /// A port over two queues; `full_for` tries answer "queue full" before it takes a frame.
     struct Queues {
@@ -183,12 +190,11 @@ mod tests {
         }
     }
 
-    fn sync(tick: u32, counter: &mut E2eCounter) -> Frame {
-        AnyMessage::Sync(Sync {
+    fn sync(tick: u32, sender: &mut Sender) -> Frame {
+        let sync = AnyMessage::Sync(Sync {
             tick: protocol::Tick::from_raw(tick).unwrap(),
-        })
-        .encode(counter.advance())
-        .unwrap()
+        });
+        sender.seal(&SESSION, &sync).unwrap()
     }
 
     fn queues(frames: &[Frame]) -> Queues {
@@ -205,9 +211,9 @@ mod tests {
 
     #[test]
     fn through_sync_stops_after_the_sync_and_names_its_tick() {
-        let mut node = Node::new(Config::ROBOT).unwrap();
-        let mut counter = E2eCounter::default();
-        let frames = [sync(7, &mut counter), sync(8, &mut counter)];
+        let mut node = node();
+        let mut sender = Sender::new();
+        let frames = [sync(7, &mut sender), sync(8, &mut sender)];
         let mut port = queues(&frames);
         let rx = receive(&mut node, Tick(0), &mut port, Drain::ThroughSync, 8).unwrap();
         assert_eq!((rx.frames, rx.rejected, rx.sync_tick), (1, 0, Some(7)));
@@ -219,9 +225,9 @@ mod tests {
 
     #[test]
     fn a_refused_sync_is_counted_and_ticks_nothing() {
-        let mut node = Node::new(Config::ROBOT).unwrap();
-        let mut counter = E2eCounter::default();
-        let good = sync(3, &mut counter);
+        let mut node = node();
+        let mut sender = Sender::new();
+        let good = sync(3, &mut sender);
         let mut data = [0_u8; 64];
         let len = good.data().len();
         data[..len].copy_from_slice(good.data());
@@ -234,9 +240,9 @@ mod tests {
 
     #[test]
     fn the_limit_bounds_a_flood() {
-        let mut node = Node::new(Config::ROBOT).unwrap();
-        let mut counter = E2eCounter::default();
-        let frames: [Frame; 5] = core::array::from_fn(|k| sync(k as u32, &mut counter));
+        let mut node = node();
+        let mut sender = Sender::new();
+        let frames: [Frame; 5] = core::array::from_fn(|k| sync(k as u32, &mut sender));
         let mut port = queues(&frames);
         let rx = receive(&mut node, Tick(0), &mut port, Drain::All, 2).unwrap();
         assert_eq!((rx.frames, rx.sync_tick), (2, Some(1)));
@@ -244,7 +250,7 @@ mod tests {
 
     #[test]
     fn send_all_counts_the_frames_the_port_took() {
-        let mut node = Node::new(Config::ROBOT).unwrap();
+        let mut node = node();
         let stop = node.stop_frames();
         let mut port = queues(&[]);
         assert_eq!(send_all(&mut port, &stop).unwrap(), stop.len() as u32);
@@ -260,7 +266,7 @@ mod tests {
 
     #[test]
     fn transmit_sends_the_tick_s_frames_and_counts_a_full_queue() {
-        let mut node = Node::new(Config::ROBOT).unwrap();
+        let mut node = node();
         let mut port = queues(&[]);
         let done = transmit(&mut node, Tick(0), &mut port).unwrap();
         assert!(done.sent >= 2, "tick 0 sends at least legs and wheels");
