@@ -11,8 +11,8 @@ use firmware::{Config, Controller, Tick};
 use proptest::prelude::*;
 use protocol::{
     Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, EStop, EStopAction, FaultFlags, Imu,
-    JointVelocity, Joints, Leg, LegFeedback, NodeId, QuatComponent, SpeedScale, TeleopCommand,
-    TeleopHeartbeat, TeleopMode, Torque, WheelAngle, WheelFeedback, WheelVelocity,
+    JointVelocity, Joints, Leg, LegFeedback, NodeId, QuatComponent, ReleaseToken, SpeedScale,
+    TeleopCommand, TeleopHeartbeat, TeleopMode, Torque, WheelAngle, WheelFeedback, WheelVelocity,
 };
 
 const CONFIG: Config = Config::ROBOT;
@@ -28,10 +28,11 @@ struct Bench {
     pitch_rad: f32,
 }
 
+/// A latch, or a release (the controller takes any token: the node checks it).
 fn estop(action: EStopAction) -> AnyMessage {
-    AnyMessage::EStop(EStop {
-        action,
-        source: NodeId::Tool,
+    AnyMessage::EStop(match action {
+        EStopAction::Latch => EStop::latch(NodeId::Tool),
+        EStopAction::Clear => EStop::release(NodeId::Tool, ReleaseToken::new(0)),
     })
 }
 
@@ -48,6 +49,15 @@ impl Bench {
             teleop_alive: true,
             pitch_rad: 0.0,
         }
+    }
+
+    /// A bench run for 5 ticks whose operator has pressed X (STOP): the restart interlock is
+    /// released and the next new key acts.
+    fn ready() -> Self {
+        let mut bench = Self::new();
+        bench.run(5);
+        bench.send(command(TeleopMode::Stop));
+        bench
     }
 
     fn send(&mut self, message: AnyMessage) {
@@ -115,8 +125,7 @@ fn drives_stay_torque_free_until_every_drive_has_reported() {
 
 #[test]
 fn w_folds_the_legs_at_the_fold_rate_then_drives_on_the_wheels() {
-    let mut bench = Bench::new();
-    bench.run(5);
+    let mut bench = Bench::ready();
     bench.send(command(TeleopMode::WheelForward));
     let output = bench.tick();
     assert_eq!(
@@ -157,8 +166,7 @@ fn w_folds_the_legs_at_the_fold_rate_then_drives_on_the_wheels() {
 
 #[test]
 fn trot_from_the_wheels_stands_up_first() {
-    let mut bench = Bench::new();
-    bench.run(5);
+    let mut bench = Bench::ready();
     bench.send(command(TeleopMode::Fold));
     bench.run(400);
     assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
@@ -181,8 +189,7 @@ fn trot_from_the_wheels_stands_up_first() {
 
 #[test]
 fn silent_feedback_safe_stops_within_fifty_milliseconds() {
-    let mut bench = Bench::new();
-    bench.run(5);
+    let mut bench = Bench::ready();
     bench.send(command(TeleopMode::TrotForward));
     bench.run(300);
     assert!(matches!(bench.state(), State::Legs(LegMotion::Trot(_))));
@@ -212,8 +219,7 @@ fn silent_feedback_safe_stops_within_fifty_milliseconds() {
 
 #[test]
 fn a_silent_operator_stops_the_robot_within_half_a_second_of_teleop_dying() {
-    let mut bench = Bench::new();
-    bench.run(5);
+    let mut bench = Bench::ready();
     bench.send(command(TeleopMode::TrotForward));
     bench.run(300);
     while bench.now % 5 != 1 {
@@ -238,17 +244,68 @@ fn a_silent_operator_stops_the_robot_within_half_a_second_of_teleop_dying() {
         .status
         .faults
         .contains(FaultFlags::TELEOP_TIMEOUT));
-    // The operator comes back still holding L: no restart without a new key.
+    // The operator comes back still holding L: no restart without a new key, and the lost
+    // operator engaged the restart interlock, so not even a new key acts before X.
     bench.teleop_alive = true;
     bench.send(command(TeleopMode::TrotForward));
     bench.run(20);
     assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
+    bench.send(command(TeleopMode::TrotBackward));
+    let output = bench.run(20);
+    assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
+    assert!(output.status.faults.contains(FaultFlags::AWAITING_STOP));
+    bench.send(command(TeleopMode::Stop));
+    bench.send(command(TeleopMode::TrotForward));
+    let output = bench.tick();
+    assert!(matches!(bench.state(), State::Legs(LegMotion::Trot(_))));
+    assert!(!output.status.faults.contains(FaultFlags::AWAITING_STOP));
+}
+
+#[test]
+fn no_request_but_stop_acts_after_start_or_a_release_until_a_stop_arrives() {
+    let mut bench = Bench::new();
+    let output = bench.run(5);
+    assert!(output.status.faults.contains(FaultFlags::AWAITING_STOP));
+    // A teleop that holds W from before the controller started moves nothing, nor does any
+    // other key.
+    for mode in [
+        TeleopMode::WheelForward,
+        TeleopMode::Stand,
+        TeleopMode::Fold,
+    ] {
+        bench.send(command(mode));
+        bench.run(5);
+        assert_eq!(bench.state(), State::Hold, "{mode:?} before a STOP");
+    }
+    // X, then W: the next new request acts.
+    bench.send(command(TeleopMode::Stop));
+    assert!(!bench
+        .tick()
+        .status
+        .faults
+        .contains(FaultFlags::AWAITING_STOP));
+    bench.send(command(TeleopMode::WheelForward));
+    bench.tick();
+    assert!(matches!(bench.state(), State::Folding(_)));
+    // An E-stop released: the robot holds, interlocked again.
+    bench.send(estop(EStopAction::Latch));
+    bench.tick();
+    bench.send(estop(EStopAction::Clear));
+    let output = bench.tick();
+    assert_eq!(bench.state(), State::Hold);
+    assert!(output.status.faults.contains(FaultFlags::AWAITING_STOP));
+    bench.send(command(TeleopMode::Fold));
+    bench.run(5);
+    assert_eq!(bench.state(), State::Hold, "a new key before X");
+    bench.send(command(TeleopMode::Stop));
+    bench.send(command(TeleopMode::Fold));
+    bench.tick();
+    assert_eq!(bench.state(), State::Folding(WheelMotion::Balance));
 }
 
 #[test]
 fn an_estop_latches_until_an_explicit_clear() {
-    let mut bench = Bench::new();
-    bench.run(5);
+    let mut bench = Bench::ready();
     bench.send(command(TeleopMode::WheelForward));
     bench.run(300);
     bench.send(estop(EStopAction::Latch));
@@ -276,8 +333,7 @@ fn an_estop_latches_until_an_explicit_clear() {
 
 #[test]
 fn a_fall_is_a_fault() {
-    let mut bench = Bench::new();
-    bench.run(5);
+    let mut bench = Bench::ready();
     bench.send(command(TeleopMode::WheelForward));
     bench.run(100);
     bench.pitch_rad = 1.0;
@@ -299,8 +355,7 @@ fn a_drive_fault_stops_the_robot_until_the_drive_recovers_and_the_operator_reset
             },
         )
     };
-    let mut bench = Bench::new();
-    bench.run(5);
+    let mut bench = Bench::ready();
     bench.send(command(TeleopMode::TrotForward));
     bench.run(300);
     bench.send(status(DriveFlags::ENABLED.with(DriveFlags::FAULT)));

@@ -2,21 +2,26 @@
 
 mod common;
 
+use common::seal;
 use firmware::control::fsm::{Direction, LegMotion, State, WheelMotion};
 use firmware::node::TELEOP_COMMANDS_PER_TICK;
 use firmware::{Config, Node, Tick};
 use protocol::{
-    decode_frame, AnyMessage, DecodeError, DriveEnable, EStop, EStopAction, Joints, MessageId,
-    NodeId, RejectCause, TeleopHeartbeat, TeleopMode,
+    classic_latch, decode_frame, AnyMessage, DecodeError, DriveEnable, EStop, Joints, MessageId,
+    NodeId, RejectCause, Sender, TeleopHeartbeat, TeleopMode,
 };
 
-fn teleop_frame(mode: TeleopMode, counter: u16) -> protocol::Frame {
-    common::command(mode).encode(counter).unwrap()
+fn node() -> Node {
+    common::node(Config::ROBOT)
+}
+
+fn teleop_frame(teleop: &mut Sender, mode: TeleopMode) -> protocol::Frame {
+    seal(teleop, &common::command(mode))
 }
 
 #[test]
 fn sends_the_bus_schedule_at_250_hz() {
-    let mut node = Node::new(Config::ROBOT).unwrap();
+    let mut node = node();
     let mut counts = std::collections::HashMap::new();
     for tick in 0..250 {
         let (_, frames) = node.poll(Tick(tick));
@@ -29,20 +34,37 @@ fn sends_the_bus_schedule_at_250_hz() {
     assert_eq!(counts[&MessageId::WheelCommand], 250);
     assert_eq!(counts[&MessageId::ControllerStatus], 50);
     assert_eq!(counts[&MessageId::RejectCounters], 10);
+    // The session announcement on the first poll, then at 10 Hz (phase 14 of 25 ticks).
+    assert_eq!(counts[&MessageId::Announce], 1 + 10);
     assert_eq!(node.encode_failures(), 0);
 }
 
 #[test]
 fn a_corrupted_frame_is_rejected_counted_and_never_applied() {
-    let mut node = Node::new(Config::ROBOT).unwrap();
-    let good = teleop_frame(TeleopMode::WheelForward, 0);
+    let mut node = node();
+    let mut teleop = Sender::new();
+    let stop = teleop_frame(&mut teleop, TeleopMode::Stop);
+    node.on_frame(Tick(0), stop.id(), stop.data()).unwrap();
+    let good = teleop_frame(&mut teleop, TeleopMode::WheelForward);
     let mut bad = good.data().to_vec();
     bad[6] ^= 0x01; // flip a payload bit
     assert!(matches!(
         node.on_frame(Tick(0), good.id(), &bad),
-        Err(DecodeError::CrcMismatch { .. })
+        Err(DecodeError::Unauthentic { .. })
     ));
     assert_eq!(node.controller().state(), State::Hold);
+    assert_eq!(
+        node.reject_counters().get(RejectCause::Unauthentic).raw(),
+        1
+    );
+    // Feedback carries a CRC rather than a MAC: its corruption is counted as such.
+    let imu = seal(&mut Sender::new(), &AnyMessage::Imu(common::imu(0.0)));
+    let mut bad = imu.data().to_vec();
+    bad[6] ^= 0x01;
+    assert!(matches!(
+        node.on_frame(Tick(0), imu.id(), &bad),
+        Err(DecodeError::CrcMismatch { .. })
+    ));
     assert_eq!(node.reject_counters().get(RejectCause::Crc).raw(), 1);
     // Wrong length and unknown id are counted under their own causes.
     assert!(node
@@ -54,8 +76,12 @@ fn a_corrupted_frame_is_rejected_counted_and_never_applied() {
         1
     );
     assert_eq!(node.reject_counters().get(RejectCause::UnknownId).raw(), 1);
-    // A replay of an accepted frame is rejected too.
+    // The genuine frame acts; a replay of it is rejected.
     node.on_frame(Tick(0), good.id(), good.data()).unwrap();
+    assert_eq!(
+        node.controller().state(),
+        State::Folding(WheelMotion::Drive(Direction::Forward))
+    );
     assert!(node.on_frame(Tick(1), good.id(), good.data()).is_err());
     assert_eq!(node.reject_counters().get(RejectCause::Repeated).raw(), 1);
     // And the counters go out on the bus in the RejectCounters frame.
@@ -71,17 +97,20 @@ fn a_corrupted_frame_is_rejected_counted_and_never_applied() {
         }
     }
     let counters = seen.expect("a RejectCounters frame within 100 ms");
-    assert_eq!(counters.total(), 4);
+    assert_eq!(counters.total(), 5);
 }
 
 #[test]
-fn the_documented_cansend_estop_latches_and_clears() {
-    let mut node = Node::new(Config::ROBOT).unwrap();
-    // `cansend vcan0 000##129660000010A` (latch, counter 0) and `000##155B80100020A`
-    // (clear, counter 1) from docs/protocol.md.
-    let latch = [0x29, 0x66, 0x00, 0x00, 0x01, 0x0A];
-    let clear = [0x55, 0xB8, 0x01, 0x00, 0x02, 0x0A];
-    node.on_frame(Tick(0), 0x000, &latch).unwrap();
+fn a_constant_classic_latch_latches_and_only_a_release_with_the_token_clears() {
+    let mut node = node();
+    // The latch an E-stop panel or `cansend vcan0 000#ED80D3C70000010A` (source = tool) sends:
+    // eight bytes of classic CAN, a CRC over action and source, bound to no session.
+    let latch = classic_latch(NodeId::Tool, 0).unwrap();
+    assert_eq!(
+        latch.data(),
+        [0xED, 0x80, 0xD3, 0xC7, 0x00, 0x00, 0x01, 0x0A]
+    );
+    node.on_frame(Tick(0), latch.id(), latch.data()).unwrap();
     assert_eq!(node.controller().state(), State::EStop);
     let (output, frames) = node.poll(Tick(0));
     assert!(!output.legs_enabled && output.wheel_torque_nm == [0.0, 0.0]);
@@ -93,50 +122,111 @@ fn the_documented_cansend_estop_latches_and_clears() {
         })
         .unwrap();
     assert_eq!(targets.enable, DriveEnable::Disabled);
-    // The clear, next in sequence, releases it; the same latch again (now out of sequence)
-    // still acts, while a replayed clear does not.
-    node.on_frame(Tick(1), 0x000, &clear).unwrap();
+    // A release needs the key and the token the controller publishes for this latch: one
+    // with another token is refused and counted, the right one releases.
+    let mut tool = Sender::new();
+    let token = node.release_token();
+    let wrong = seal(
+        &mut tool,
+        &AnyMessage::EStop(EStop::release(NodeId::Tool, token.next())),
+    );
+    assert_eq!(
+        node.on_frame(Tick(1), wrong.id(), wrong.data()),
+        Err(DecodeError::StaleRelease { id: 0x000 })
+    );
+    assert_eq!(node.controller().state(), State::EStop);
+    let release = seal(
+        &mut tool,
+        &AnyMessage::EStop(EStop::release(NodeId::Tool, token)),
+    );
+    node.on_frame(Tick(1), release.id(), release.data())
+        .unwrap();
     assert_eq!(node.controller().state(), State::Hold);
-    node.on_frame(Tick(2), 0x000, &latch).unwrap();
+    // The same latch again still acts (a stale latch can only stop the robot), and gets a
+    // new token; neither the replayed release nor a fresh one with the old token releases it.
+    node.on_frame(Tick(2), latch.id(), latch.data()).unwrap();
     assert_eq!(node.controller().state(), State::EStop);
-    assert!(node.on_frame(Tick(3), 0x000, &clear).is_err());
+    assert_ne!(node.release_token(), token);
+    assert!(node
+        .on_frame(Tick(3), release.id(), release.data())
+        .is_err());
+    let old = seal(
+        &mut tool,
+        &AnyMessage::EStop(EStop::release(NodeId::Tool, token)),
+    );
+    assert_eq!(
+        node.on_frame(Tick(3), old.id(), old.data()),
+        Err(DecodeError::StaleRelease { id: 0x000 })
+    );
     assert_eq!(node.controller().state(), State::EStop);
+    // A release when nothing is latched is refused as well.
+    let fresh = seal(
+        &mut tool,
+        &AnyMessage::EStop(EStop::release(NodeId::Tool, node.release_token())),
+    );
+    node.on_frame(Tick(4), fresh.id(), fresh.data()).unwrap();
+    assert_eq!(node.controller().state(), State::Hold);
+    let again = seal(
+        &mut tool,
+        &AnyMessage::EStop(EStop::release(NodeId::Tool, node.release_token())),
+    );
+    assert_eq!(
+        node.on_frame(Tick(5), again.id(), again.data()),
+        Err(DecodeError::StaleRelease { id: 0x000 })
+    );
+    assert_eq!(
+        node.reject_counters().get(RejectCause::StaleRelease).raw(),
+        3
+    );
 }
 
-/// The feedback of one tick (four legs at zero, wheels, IMU) with rolling counter `counter`.
-fn feedback_frames(counter: u16) -> Vec<protocol::Frame> {
+/// The feedback of one tick (four legs at zero, wheels, IMU), sealed with the plant's next
+/// counters.
+fn feedback_frames(plant: &mut Sender) -> Vec<protocol::Frame> {
     common::plant_feedback(&Joints::splat(0.0))
         .iter()
-        .map(|m| m.encode(counter).unwrap())
+        .map(|m| seal(plant, m))
         .collect()
 }
 
-/// Sends one teleop command per mode, counters from `*counter` on; returns how many the node
-/// applied and how many it refused as rate limited (any other refusal fails the test).
-fn flood(node: &mut Node, now: u32, modes: &[TeleopMode], counter: &mut u16) -> (u32, u32) {
+/// Sends one teleop command per mode, sealed in sequence by `teleop`; returns how many the
+/// node applied and how many it refused as rate limited (any other refusal fails the test).
+fn flood(node: &mut Node, now: u32, modes: &[TeleopMode], teleop: &mut Sender) -> (u32, u32) {
     let (mut applied, mut limited) = (0, 0);
-    for mode in modes {
-        let frame = teleop_frame(*mode, *counter);
-        *counter += 1;
+    for (k, mode) in modes.iter().enumerate() {
+        let frame = teleop_frame(teleop, *mode);
         match node.on_frame(Tick(now), frame.id(), frame.data()) {
             Ok(()) => applied += 1,
             Err(DecodeError::RateLimited { id: 0x200 }) => limited += 1,
-            Err(other) => panic!("teleop frame {counter} refused: {other:?}"),
+            Err(other) => panic!("teleop frame {k} refused: {other:?}"),
         }
     }
     (applied, limited)
 }
 
+/// A node whose restart interlock the operator has released at tick 0 (STOP, as X does),
+/// polled once, and the operator's sender.
+fn node_after_stop() -> (Node, Sender) {
+    let mut node = node();
+    let mut teleop = Sender::new();
+    assert_eq!(
+        flood(&mut node, 0, &[TeleopMode::Stop], &mut teleop),
+        (1, 0)
+    );
+    node.poll(Tick(0));
+    (node, teleop)
+}
+
 #[test]
 fn a_teleop_flood_is_rate_limited_per_tick_and_counted_and_other_traffic_still_flows() {
     assert_eq!(TELEOP_COMMANDS_PER_TICK, 2);
-    let mut node = Node::new(Config::ROBOT).unwrap();
-    let mut counter = 0;
+    let (mut node, mut teleop) = node_after_stop();
+    let mut plant = Sender::new();
     // 10 000 frames/s from a babbling teleop: 40 valid frames, in sequence, in one 4 ms tick.
     // The first two act (Stand, then trot); any of the 38 Folds after them would fold the legs.
     let mut modes = vec![TeleopMode::Stand, TeleopMode::TrotForward];
     modes.extend([TeleopMode::Fold; 38]);
-    assert_eq!(flood(&mut node, 0, &modes, &mut counter), (2, 38));
+    assert_eq!(flood(&mut node, 1, &modes, &mut teleop), (2, 38));
     assert_eq!(
         node.controller().state(),
         State::Standing(LegMotion::Trot(Direction::Forward))
@@ -147,42 +237,41 @@ fn a_teleop_flood_is_rate_limited_per_tick_and_counted_and_other_traffic_still_f
     );
     assert_eq!(node.reject_counters().total(), 38);
     // The rest of the bus is served in the same tick: feedback, heartbeats (not limited).
-    for frame in feedback_frames(0) {
-        node.on_frame(Tick(0), frame.id(), frame.data())
+    for frame in feedback_frames(&mut plant) {
+        node.on_frame(Tick(1), frame.id(), frame.data())
             .unwrap_or_else(|e| panic!("feedback {:03X} refused: {e:?}", frame.id()));
     }
     for n in 0..40 {
         let heartbeat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
             uptime: protocol::Millis::from_raw(n).unwrap(),
-        })
-        .encode(n as u16)
-        .unwrap();
-        node.on_frame(Tick(0), heartbeat.id(), heartbeat.data())
+        });
+        let heartbeat = seal(&mut teleop, &heartbeat);
+        node.on_frame(Tick(1), heartbeat.id(), heartbeat.data())
             .unwrap();
     }
-    let (output, _) = node.poll(Tick(0));
+    let (output, _) = node.poll(Tick(1));
     assert!(output.legs_enabled, "the feedback armed the drives");
     // The next tick has a new budget, and the limited frames kept the sequence in step: the
     // next two act (stop, then fold), the rest is limited again, none is out of sequence.
     let mut modes = vec![TeleopMode::Stop, TeleopMode::Fold];
     modes.extend([TeleopMode::Stand; 38]);
-    assert_eq!(flood(&mut node, 1, &modes, &mut counter), (2, 38));
+    assert_eq!(flood(&mut node, 2, &modes, &mut teleop), (2, 38));
     assert_eq!(
         node.controller().state(),
         State::Folding(WheelMotion::Balance)
     );
-    for frame in feedback_frames(1) {
-        node.on_frame(Tick(1), frame.id(), frame.data()).unwrap();
+    for frame in feedback_frames(&mut plant) {
+        node.on_frame(Tick(2), frame.id(), frame.data()).unwrap();
     }
     let counters = node.reject_counters();
     assert_eq!(counters.get(RejectCause::RateLimited).raw(), 76);
     assert_eq!(counters.total(), 76);
     assert_eq!(counters.lost.raw(), 0);
     // The limit holds per tick, whatever the gap between ticks: one command per poll is served.
-    for tick in 2..50 {
+    for tick in 3..50 {
         node.poll(Tick(tick));
         assert_eq!(
-            flood(&mut node, tick, &[TeleopMode::Fold], &mut counter),
+            flood(&mut node, tick, &[TeleopMode::Fold], &mut teleop),
             (1, 0)
         );
     }
@@ -190,10 +279,9 @@ fn a_teleop_flood_is_rate_limited_per_tick_and_counted_and_other_traffic_still_f
 
 #[test]
 fn an_estop_in_a_teleop_flood_acts() {
-    let mut node = Node::new(Config::ROBOT).unwrap();
-    let mut counter = 0;
+    let (mut node, mut teleop) = node_after_stop();
     assert_eq!(
-        flood(&mut node, 0, &[TeleopMode::Fold; 20], &mut counter),
+        flood(&mut node, 1, &[TeleopMode::Fold; 20], &mut teleop),
         (2, 18)
     );
     assert_eq!(
@@ -201,22 +289,20 @@ fn an_estop_in_a_teleop_flood_acts() {
         State::Folding(WheelMotion::Balance)
     );
     // The budget is spent, and an E-stop still acts at once.
-    let latch = AnyMessage::EStop(EStop {
-        action: EStopAction::Latch,
-        source: NodeId::Teleop,
-    })
-    .encode(0)
-    .unwrap();
-    node.on_frame(Tick(0), latch.id(), latch.data())
+    let latch = seal(
+        &mut teleop,
+        &AnyMessage::EStop(EStop::latch(NodeId::Teleop)),
+    );
+    node.on_frame(Tick(1), latch.id(), latch.data())
         .expect("an E-stop is never rate limited");
     assert_eq!(node.controller().state(), State::EStop);
     assert_eq!(
-        flood(&mut node, 0, &[TeleopMode::Fold; 20], &mut counter),
+        flood(&mut node, 1, &[TeleopMode::Fold; 20], &mut teleop),
         (0, 20)
     );
-    node.poll(Tick(0));
+    node.poll(Tick(1));
     assert_eq!(
-        flood(&mut node, 1, &[TeleopMode::Stand; 40], &mut counter),
+        flood(&mut node, 2, &[TeleopMode::Stand; 40], &mut teleop),
         (2, 38)
     );
     assert_eq!(node.controller().state(), State::EStop);

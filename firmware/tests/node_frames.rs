@@ -3,21 +3,24 @@
 //!
 //! Frames are drawn so that most get past the cheap checks and reach the field decoding and the
 //! controller: a known identifier with its exact wire length, arbitrary payload bytes and a
-//! correct CRC with a plausible counter; besides those, corrupted copies, wrong lengths, random
-//! identifiers and stale counters.
+//! check value (CRC or MAC, as the identifier takes) valid in the node's session at a
+//! plausible counter; besides those, corrupted copies, wrong lengths, random identifiers and
+//! stale or far-ahead counters.
 
 use firmware::limits::Joint;
-use firmware::{Config, Node, Tick};
+use firmware::{Config, Tick};
 use proptest::prelude::*;
-use protocol::e2e::protect;
-use protocol::{decode_frame, AnyMessage, MessageId};
+use protocol::e2e::{protect, Freshness, HEADER_LEN};
+use protocol::{decode_frame, protection_of, AnyMessage, MessageId, Session, TEST_KEY};
+
+mod common;
 
 const CONFIG: Config = Config::ROBOT;
 
 /// How one frame of the test is made.
 #[derive(Debug, Clone)]
 enum Draw {
-    /// A known id, its length, these payload bytes, a valid CRC, the next counter plus `skip`.
+    /// A known id, its length, these payload bytes, a valid check, the next counter plus `skip`.
     Sealed {
         id: usize,
         payload: Vec<u8>,
@@ -47,17 +50,41 @@ fn draw() -> impl Strategy<Value = Draw> {
 }
 
 /// Builds the frame of `draw`, advancing the per-id counters.
-fn build(draw: &Draw, counters: &mut [u16; MessageId::ALL.len()]) -> (u16, Vec<u8>) {
-    let sealed = |id: usize, payload: &[u8], skip: u16, counters: &mut [u16; 19]| {
-        let message = MessageId::ALL[id];
-        let layout = message.layout();
-        let mut data = vec![0; layout.wire_len];
-        let end = layout.len.min(data.len());
-        data[4..end].copy_from_slice(&payload[..end - 4]);
-        counters[id] = counters[id].wrapping_add(1).wrapping_add(skip);
-        protect(message.data_id(), counters[id], &mut data[..end]);
-        (message.raw(), data)
-    };
+fn build(draw: &Draw, counters: &mut [u32; MessageId::ALL.len()]) -> (u16, Vec<u8>) {
+    let session: Session = common::SESSION;
+    let sealed =
+        |id: usize, payload: &[u8], skip: u16, counters: &mut [u32; MessageId::ALL.len()]| {
+            let message = MessageId::ALL[id];
+            let layout = message.layout();
+            let mut data = vec![0; layout.wire_len];
+            let end = layout.len.min(data.len());
+            data[HEADER_LEN..end].copy_from_slice(&payload[..end - HEADER_LEN]);
+            counters[id] = counters[id].wrapping_add(1).wrapping_add(u32::from(skip));
+            // As a sender would: the check the payload's identifier (and action) takes, bound to
+            // the session if it is, at the full counter, or the low half for a frame outside
+            // the sequence.
+            let (protection, covered) = protection_of(message, &data);
+            let freshness = Freshness {
+                data_id: message.data_id(),
+                epoch: if protection.bound {
+                    session.epoch()
+                } else {
+                    None
+                },
+                counter: if protection.sequenced {
+                    counters[id]
+                } else {
+                    counters[id] & 0xFFFF
+                },
+            };
+            protect(
+                protection.check,
+                &TEST_KEY,
+                &freshness,
+                &mut data[..HEADER_LEN + covered],
+            );
+            (message.raw(), data)
+        };
     match draw {
         Draw::Sealed { id, payload, skip } => sealed(*id, payload, *skip, counters),
         Draw::Flipped { id, payload, bit } => {
@@ -79,8 +106,8 @@ proptest! {
     fn no_frame_sequence_yields_an_unsafe_command(
         script in prop::collection::vec((prop::collection::vec(draw(), 0..12), 1u32..30), 1..100)
     ) {
-        let mut node = Node::new(CONFIG).unwrap();
-        let mut counters = [0u16; MessageId::ALL.len()];
+        let mut node = common::node(CONFIG);
+        let mut counters = [0u32; MessageId::ALL.len()];
         let mut now = 0u32;
         let mut refused = 0u32;
         for (draws, gap) in script {

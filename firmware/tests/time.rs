@@ -3,13 +3,11 @@
 
 mod common;
 
-use std::collections::HashMap;
-
 use firmware::control::fsm::{Direction, LegMotion, State};
 use firmware::control::safety::Watchdog;
 use firmware::legs::smoothing::Smoother;
 use firmware::{Config, Node, Tick, TickRate};
-use protocol::{AnyMessage, FaultFlags, TeleopHeartbeat, TeleopMode};
+use protocol::{AnyMessage, FaultFlags, Sender, TeleopHeartbeat, TeleopMode};
 
 #[test]
 fn milliseconds_round_up_to_whole_ticks() {
@@ -54,16 +52,15 @@ fn the_reports_smoothing_in_ticks() {
 #[test]
 fn a_node_trots_on_across_the_tick_counter_wrap() {
     // Started 4 s before its tick counter wraps (about 199 days of uptime at 250 Hz), on an
-    // ideal plant with the operator holding L: it must trot through the wrap without a
-    // watchdog, the link monitor or the schedule noticing anything.
+    // ideal plant with the operator holding L (after the X that releases the restart
+    // interlock): it must trot through the wrap without a watchdog, the link monitor or the
+    // schedule noticing anything.
     let config = Config::ROBOT;
-    let mut node = Node::new(config).unwrap();
+    let mut node = common::node(config);
     let mut joints = common::standing_joints_rad(&config);
-    let mut counters: HashMap<u16, u16> = HashMap::new();
+    let mut bus = Sender::new();
     let mut send = |node: &mut Node, now: Tick, message: AnyMessage| {
-        let counter = counters.entry(message.id().raw()).or_insert(0);
-        let frame = message.encode(*counter).unwrap();
-        *counter = counter.wrapping_add(1);
+        let frame = common::seal(&mut bus, &message);
         node.on_frame(now, frame.id(), frame.data()).unwrap();
     };
     let start = Tick(u32::MAX - 1000);
@@ -72,6 +69,9 @@ fn a_node_trots_on_across_the_tick_counter_wrap() {
         let now = start.plus(k);
         for message in common::plant_feedback(&joints) {
             send(&mut node, now, message);
+        }
+        if k == 0 {
+            send(&mut node, now, common::command(TeleopMode::Stop));
         }
         if k % 5 == 0 {
             send(&mut node, now, common::command(TeleopMode::TrotForward));

@@ -1,13 +1,31 @@
-//! Shared by the firmware's closed-loop benches: the pose they start in, and the messages an
-//! ideal plant and operator send. Each test binary uses part of it.
+//! Shared by the firmware's closed-loop benches: the pose they start in, the messages an
+//! ideal plant and operator send, and the bus session they send them in. Each test binary uses
+//! part of it.
 #![allow(dead_code)]
 
 use firmware::config::Config;
+use firmware::Node;
 use protocol::{
-    Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, Imu, JointVelocity, Joints,
-    LegFeedback, QuatComponent, SpeedScale, TeleopCommand, TeleopMode, Torque, WheelAngle,
-    WheelFeedback, WheelVelocity,
+    Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, Epoch, Frame, Imu, JointVelocity,
+    Joints, LegFeedback, QuatComponent, Sender, Session, SpeedScale, TeleopCommand, TeleopMode,
+    Torque, WheelAngle, WheelFeedback, WheelVelocity, TEST_KEY,
 };
+
+/// The session the node under test opens (the simulation's key, epoch 1); the test's other
+/// nodes (plant, operator) seal their frames in it, as if they had heard its announcement.
+pub const SESSION: Session = Session::owned(TEST_KEY, Epoch::new(1));
+
+/// A controller node running `config` in [`SESSION`].
+pub fn node(config: Config) -> Node {
+    Node::new(config, SESSION).expect("a valid configuration")
+}
+
+/// `message` sealed in [`SESSION`] with the next counter of its identifier in `sender`.
+pub fn seal(sender: &mut Sender, message: &AnyMessage) -> Frame {
+    sender
+        .seal(&SESSION, message)
+        .expect("the session is joined")
+}
 
 /// Every leg at the nominal stance of `config`, rad: the robot standing.
 pub fn standing_joints_rad(config: &Config) -> Joints<f32> {
