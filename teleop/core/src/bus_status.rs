@@ -115,9 +115,11 @@ impl BusStatus {
 mod tests {
     use super::*;
     use protocol::{
-        Angle, BodyHeight, ControllerMode, FaultFlags, Tick, Torque, WheelAngle, WheelFeedback,
-        WheelVelocity,
+        Angle, BodyHeight, ControllerMode, Epoch, FaultFlags, ReleaseToken, Session, Tick, Torque,
+        WheelAngle, WheelFeedback, WheelVelocity, TEST_KEY,
     };
+
+    const SESSION: Session = Session::owned(TEST_KEY, Epoch::new(1));
 
     fn status(mode: ControllerMode) -> Frame {
         AnyMessage::ControllerStatus(ControllerStatus {
@@ -127,8 +129,9 @@ mod tests {
             body_height: BodyHeight::saturating_from_si(0.0),
             pitch: Angle::saturating_from_si(0.1),
             roll: Angle::saturating_from_si(0.0),
+            release_token: ReleaseToken::new(0),
         })
-        .encode(0)
+        .encode(&SESSION, 0)
         .unwrap()
     }
 
@@ -138,7 +141,7 @@ mod tests {
             velocity: [WheelVelocity::saturating_from_si(speed); 2],
             effort: [Torque::saturating_from_si(0.0); 2],
         })
-        .encode(0)
+        .encode(&SESSION, 0)
         .unwrap()
     }
 
