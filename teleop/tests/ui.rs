@@ -1,10 +1,10 @@
 //! The terminal UI on ratatui's test backend: keys in, frames out, the bus status on screen.
 
 use protocol::{
-    Angle, AnyMessage, BodyHeight, ControllerMode, ControllerStatus, Count, Drive, DriveFlags,
-    DriveStatus, EStop, EStopAction, FaultFlags, Frame, MessageId, Receiver, RejectCause,
-    RejectCounters, TeleopCommand, TeleopMode, Tick, Torque, WheelAngle, WheelFeedback,
-    WheelVelocity,
+    Angle, Announce, AnyMessage, BodyHeight, ControllerMode, ControllerStatus, Count, Drive,
+    DriveFlags, DriveStatus, EStop, EStopAction, Epoch, FaultFlags, Frame, MessageId, Receiver,
+    RejectCause, RejectCounters, ReleaseToken, Sender, Session, TeleopCommand, TeleopMode, Tick,
+    Torque, WheelAngle, WheelFeedback, WheelVelocity, WireVersion, TEST_KEY,
 };
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
@@ -26,44 +26,74 @@ fn screen(app: &App, now_ms: u64) -> String {
         .join("\n")
 }
 
-fn decode_all(frames: &[Frame], rx: &mut Receiver) -> Vec<AnyMessage> {
-    frames
-        .iter()
-        .map(|f| rx.receive(f.id(), f.data()).unwrap().message)
-        .collect()
+/// The rest of the bus as the operator hears it: the controller's session (its announcement
+/// and status, and its receiver for what the operator sends) and the drives' feedback.
+struct Robot {
+    session: Session,
+    sender: Sender,
+    rx: Receiver,
 }
 
-fn status(mode: ControllerMode, faults: FaultFlags) -> Frame {
-    AnyMessage::ControllerStatus(ControllerStatus {
-        mode,
-        faults,
-        tick: Tick::from_raw(100).unwrap(),
-        body_height: BodyHeight::saturating_from_si(-0.02),
-        pitch: Angle::saturating_from_si(0.05),
-        roll: Angle::saturating_from_si(-0.01),
-    })
-    .encode(0)
-    .unwrap()
-}
+impl Robot {
+    fn new() -> Self {
+        let session = Session::owned(TEST_KEY, Epoch::new(1));
+        Self {
+            session,
+            sender: Sender::new(),
+            rx: Receiver::owner(session),
+        }
+    }
 
-fn wheels(left: f32, right: f32) -> Frame {
-    AnyMessage::WheelFeedback(WheelFeedback {
-        position: [WheelAngle::saturating_from_si(0.0); 2],
-        velocity: [
-            WheelVelocity::saturating_from_si(left),
-            WheelVelocity::saturating_from_si(right),
-        ],
-        effort: [Torque::saturating_from_si(0.0); 2],
-    })
-    .encode(0)
-    .unwrap()
+    fn seal(&mut self, message: AnyMessage) -> Frame {
+        self.sender.seal(&self.session, &message).unwrap()
+    }
+
+    fn announce(&mut self) -> Frame {
+        self.seal(AnyMessage::Announce(Announce {
+            version: WireVersion::THIS,
+            epoch: Epoch::new(1),
+        }))
+    }
+
+    /// The controller's status; a release must echo token 4.
+    fn status(&mut self, mode: ControllerMode, faults: FaultFlags) -> Frame {
+        self.seal(AnyMessage::ControllerStatus(ControllerStatus {
+            mode,
+            faults,
+            tick: Tick::from_raw(100).unwrap(),
+            body_height: BodyHeight::saturating_from_si(-0.02),
+            pitch: Angle::saturating_from_si(0.05),
+            roll: Angle::saturating_from_si(-0.01),
+            release_token: ReleaseToken::new(4),
+        }))
+    }
+
+    fn wheels(&mut self, left: f32, right: f32) -> Frame {
+        self.seal(AnyMessage::WheelFeedback(WheelFeedback {
+            position: [WheelAngle::saturating_from_si(0.0); 2],
+            velocity: [
+                WheelVelocity::saturating_from_si(left),
+                WheelVelocity::saturating_from_si(right),
+            ],
+            effort: [Torque::saturating_from_si(0.0); 2],
+        }))
+    }
+
+    /// What the controller makes of the operator's frames (every one must be accepted).
+    fn decode_all(&mut self, frames: &[Frame]) -> Vec<AnyMessage> {
+        frames
+            .iter()
+            .map(|f| self.rx.receive(f.id(), f.data()).unwrap().message)
+            .collect()
+    }
 }
 
 #[test]
 fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
     let mut app = App::new("vcan0");
-    let mut rx = Receiver::default();
-    let first = decode_all(&app.poll(0).unwrap(), &mut rx);
+    let mut robot = Robot::new();
+    app.observe(0, &robot.announce());
+    let first = robot.decode_all(&app.poll(0).unwrap());
     assert!(matches!(
         first.as_slice(),
         [
@@ -75,7 +105,7 @@ fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
         ]
     ));
     app.key(5, Key::Char('l'));
-    let sent = decode_all(&app.poll(5).unwrap(), &mut rx);
+    let sent = robot.decode_all(&app.poll(5).unwrap());
     assert!(
         matches!(
             sent.as_slice(),
@@ -91,7 +121,7 @@ fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
 
     app.key(9, Key::Up);
     app.key(9, Key::Char('['));
-    let sent = decode_all(&app.poll(9).unwrap(), &mut rx);
+    let sent = robot.decode_all(&app.poll(9).unwrap());
     let AnyMessage::TeleopCommand(command) = sent[0] else {
         panic!("{sent:?}")
     };
@@ -100,7 +130,7 @@ fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
     assert!(screen(&app, 9).contains("height +0.01 m   speed 90 %"));
 
     app.key(12, Key::Char(' '));
-    let sent = decode_all(&app.poll(12).unwrap(), &mut rx);
+    let sent = robot.decode_all(&app.poll(12).unwrap());
     assert!(matches!(
         sent.first(),
         Some(AnyMessage::EStop(EStop {
@@ -112,7 +142,7 @@ fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
     let shown = screen(&app, 12);
     assert!(shown.contains("E-STOP SENT, not yet confirmed"), "{shown}");
     assert!(shown.contains("command X stop"), "{shown}");
-    let again = decode_all(&app.poll(16).unwrap(), &mut rx);
+    let again = robot.decode_all(&app.poll(16).unwrap());
     assert!(
         again.iter().any(|m| matches!(
             m,
@@ -126,12 +156,12 @@ fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
     // The controller reports it: the screen shows the controller's state, and the latch stops.
     app.observe(
         18,
-        &status(ControllerMode::EStop, FaultFlags::ESTOP_LATCHED),
+        &robot.status(ControllerMode::EStop, FaultFlags::ESTOP_LATCHED),
     );
     let shown = screen(&app, 18);
     assert!(shown.contains("E-STOP LATCHED, confirmed"), "{shown}");
     for t in 19..60 {
-        let frames = decode_all(&app.poll(t).unwrap(), &mut rx);
+        let frames = robot.decode_all(&app.poll(t).unwrap());
         assert!(
             !frames.iter().any(|m| matches!(m, AnyMessage::EStop(_))),
             "t {t}: {frames:?}"
@@ -141,15 +171,22 @@ fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
     app.key(100, Key::Char('r'));
     assert!(screen(&app, 100).contains("press R again within 2 s"));
     app.key(200, Key::Char('R'));
-    let sent = decode_all(&app.poll(200).unwrap(), &mut rx);
-    assert!(matches!(
-        sent.first(),
-        Some(AnyMessage::EStop(EStop {
-            action: EStopAction::Clear,
-            ..
-        }))
-    ));
-    app.observe(201, &status(ControllerMode::Stop, FaultFlags::EMPTY));
+    let sent = robot.decode_all(&app.poll(200).unwrap());
+    assert!(
+        matches!(
+            sent.first(),
+            Some(AnyMessage::EStop(EStop {
+                action: EStopAction::Clear,
+                token,
+                ..
+            })) if token.raw() == 4
+        ),
+        "the release echoes the controller's token: {sent:?}"
+    );
+    app.observe(
+        201,
+        &robot.status(ControllerMode::Stop, FaultFlags::AWAITING_STOP),
+    );
     let shown = screen(&app, 201);
     assert!(
         !shown.contains("E-STOP LATCHED") && !shown.contains("E-STOP SENT"),
@@ -161,7 +198,7 @@ fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
     assert!(screen(&app, 300).contains("`z` does nothing"));
     app.key(300, Key::Char('q'));
     assert!(app.quit_requested());
-    let farewell = decode_all(&app.farewell(301).unwrap(), &mut rx);
+    let farewell = robot.decode_all(&app.farewell(301).unwrap());
     assert!(
         farewell.iter().any(|m| matches!(
             m,
@@ -177,7 +214,10 @@ fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
 #[test]
 fn the_heartbeat_keeps_going_at_50_hz_without_keys() {
     let mut app = App::new("vcan0");
-    let beats: usize = (0..1_000)
+    // Nothing goes out before the controller's session is joined, not even a heartbeat.
+    assert!((0..100).all(|t| app.poll(t).unwrap().is_empty()));
+    app.observe(100, &Robot::new().announce());
+    let beats: usize = (100..1_100)
         .map(|t| {
             app.poll(t)
                 .unwrap()
@@ -187,21 +227,22 @@ fn the_heartbeat_keeps_going_at_50_hz_without_keys() {
         })
         .sum();
     assert_eq!(beats, 50);
-    assert!(screen(&app, 1_000).contains("heartbeat sent"));
+    assert!(screen(&app, 1_100).contains("heartbeat sent"));
 }
 
 #[test]
 fn the_bus_status_is_rendered_and_silence_gets_a_banner() {
     let mut app = App::new("vcan0");
+    let mut robot = Robot::new();
     let shown = screen(&app, 0);
     assert!(shown.contains("CONTROLLER SILENT (never heard)"), "{shown}");
     assert!(shown.contains("DRIVES SILENT (never heard)"), "{shown}");
 
     app.observe(
         1_000,
-        &status(ControllerMode::WheelForward, FaultFlags::TELEOP_TIMEOUT),
+        &robot.status(ControllerMode::WheelForward, FaultFlags::TELEOP_TIMEOUT),
     );
-    app.observe(1_002, &wheels(4.0, -1.5));
+    app.observe(1_002, &robot.wheels(4.0, -1.5));
     let wheel_status = DriveStatus {
         flags: DriveFlags::ENABLED,
         rejected: Count::default(),
@@ -209,9 +250,7 @@ fn the_bus_status_is_rendered_and_silence_gets_a_banner() {
     };
     app.observe(
         1_003,
-        &AnyMessage::DriveStatus(Drive::Wheel, wheel_status)
-            .encode(0)
-            .unwrap(),
+        &robot.seal(AnyMessage::DriveStatus(Drive::Wheel, wheel_status)),
     );
     let fl_status = DriveStatus {
         flags: DriveFlags::TIMED_OUT,
@@ -219,9 +258,7 @@ fn the_bus_status_is_rendered_and_silence_gets_a_banner() {
     };
     app.observe(
         1_003,
-        &AnyMessage::DriveStatus(Drive::LegFl, fl_status)
-            .encode(0)
-            .unwrap(),
+        &robot.seal(AnyMessage::DriveStatus(Drive::LegFl, fl_status)),
     );
     let mut counters = RejectCounters::default();
     for _ in 0..3 {
@@ -230,10 +267,7 @@ fn the_bus_status_is_rendered_and_silence_gets_a_banner() {
     counters.record(RejectCause::Repeated);
     counters.record(RejectCause::RateLimited);
     counters.record(RejectCause::RateLimited);
-    app.observe(
-        1_004,
-        &AnyMessage::RejectCounters(counters).encode(0).unwrap(),
-    );
+    app.observe(1_004, &robot.seal(AnyMessage::RejectCounters(counters)));
     app.set_sim(SimView {
         time_s: 12.5,
         position_m: [1.234, -0.05],
