@@ -8,7 +8,10 @@ use std::time::{Duration, Instant};
 
 use host_can::bus::Bus;
 use host_can::inproc_bus::{InprocBus, InprocEndpoint};
-use protocol::{decode_frame, AnyMessage, ControllerMode, DriveEnable, FaultFlags, Frame, Joints};
+use protocol::{
+    decode_frame, AnyMessage, ControllerMode, DriveEnable, Epoch, FaultFlags, Frame, Joints,
+    Session, TEST_KEY,
+};
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
 use sim_host::robot::imu::ImuNoise;
@@ -49,8 +52,9 @@ fn lockstep_latency(
     .unwrap();
     let bus = InprocBus::new();
     let mut sim_bus = bus.endpoint();
+    let session = Session::owned(TEST_KEY, Epoch::new(1));
     let mut controller =
-        InprocController::new(firmware_config(250).unwrap(), bus.endpoint()).unwrap();
+        InprocController::new(firmware_config(250).unwrap(), bus.endpoint(), session).unwrap();
     let mut teleop_bus = bus.endpoint();
     let mut probe = bus.endpoint();
     let mut app = App::new("inproc");
@@ -74,8 +78,11 @@ fn lockstep_latency(
                 teleop_bus.send(&frame)?;
             }
             controller.service()?;
-            // What the firmware sent in this control tick.
+            // What the firmware sent in this control tick; the operator hears it too (the
+            // announcement joins it to the session, after which it sends its STOP, and the
+            // motion key acts).
             while let Some(frame) = probe.recv(Duration::ZERO)? {
+                app.observe(now_ms, &frame);
                 let Some(targets) = leg_targets(&frame) else {
                     continue;
                 };
@@ -198,7 +205,17 @@ fn when_the_operator_goes_silent_the_controller_stops_within_500_ms() {
     let (robot, mut bus) = InprocRobot::start(InprocOptions::wall_clock());
     let start = Instant::now();
     let mut app = App::new("inproc");
-    app.key(0, Key::Char('l'));
+    // The controller starts interlocked: the operator's STOP (sent from the start) releases
+    // it, then L.
+    let armed = wait_for(
+        &mut bus,
+        &mut app,
+        start,
+        Duration::from_secs(10),
+        |f| matches!(decode_frame(f.id(), f.data()).map(|d| d.message), Ok(AnyMessage::ControllerStatus(s)) if !s.faults.contains(FaultFlags::AWAITING_STOP)),
+    );
+    assert!(armed.is_some(), "the controller never left its interlock");
+    app.key(start.elapsed().as_millis() as u64, Key::Char('l'));
     let trotting = wait_for(
         &mut bus,
         &mut app,
