@@ -8,17 +8,21 @@ use host_can::fault_plan::Faults;
 use host_can::faulty_bus::FaultyBus;
 use host_can::inproc_bus::{InprocBus, InprocEndpoint};
 use protocol::{
-    AnyMessage, BodyHeight, Frame, Receiver, RejectCause, SpeedScale, Sync, TeleopCommand,
-    TeleopMode, Tick,
+    decode_frame, Announce, AnyMessage, BodyHeight, Epoch, Frame, Receiver, RejectCause, Sender,
+    Session, SpeedScale, Sync, TeleopCommand, TeleopMode, Tick, WireVersion, TEST_KEY,
 };
 
-fn command(counter: u16) -> Frame {
+/// The controller's session, in which every frame of these tests is sealed.
+const SESSION: Session = Session::owned(TEST_KEY, Epoch::new(3));
+
+/// A teleop command with full counter `counter`.
+fn command(counter: u32) -> Frame {
     AnyMessage::TeleopCommand(TeleopCommand {
         mode: TeleopMode::TrotForward,
         body_height: BodyHeight::saturating_from_si(0.0),
         speed_scale: SpeedScale::saturating_from_si(1.0),
     })
-    .encode(counter)
+    .encode(&SESSION, counter)
     .unwrap()
 }
 
@@ -26,8 +30,13 @@ fn sync(tick: u32) -> Frame {
     AnyMessage::Sync(Sync {
         tick: Tick::from_raw(tick).unwrap(),
     })
-    .encode(tick as u16)
+    .encode(&SESSION, tick)
     .unwrap()
+}
+
+/// The low counter a frame carries.
+fn counter(frame: &Frame) -> u16 {
+    decode_frame(frame.id(), frame.data()).unwrap().counter
 }
 
 fn rig(faults: &str) -> (FaultyBus<InprocEndpoint>, InprocEndpoint) {
@@ -48,7 +57,7 @@ fn run(
 ) -> Vec<Frame> {
     let mut got = Vec::new();
     for cycle in 0..cycles {
-        faulty.send(&command(cycle as u16 + 1)).unwrap();
+        faulty.send(&command(cycle + 1)).unwrap();
         faulty.send(&sync(cycle)).unwrap();
         got.extend(drain(other));
     }
@@ -83,7 +92,7 @@ fn burst_loss_drops_whole_runs_of_cycles_at_the_planned_share() {
     let received: std::collections::BTreeSet<u16> = got
         .iter()
         .filter(|f| f.id() == command(0).id())
-        .map(|f| u16::from_le_bytes([f.data()[2], f.data()[3]]))
+        .map(counter)
         .collect();
     let lost: Vec<bool> = (1..=cycles)
         .map(|c| !received.contains(&(c as u16)))
@@ -113,10 +122,10 @@ fn delay_holds_frames_for_whole_cycles_in_order() {
                 arrival.push((cycle, frame));
             }
         }
-        faulty.send(&command(cycle as u16 + 1)).unwrap();
+        faulty.send(&command(cycle + 1)).unwrap();
         faulty.send(&sync(cycle)).unwrap();
     }
-    let expected: Vec<_> = (3..10).map(|c| (c, command(c as u16 - 2))).collect();
+    let expected: Vec<_> = (3..10).map(|c| (c, command(c - 2))).collect();
     assert_eq!(arrival, expected);
 }
 
@@ -124,12 +133,11 @@ fn delay_holds_frames_for_whole_cycles_in_order() {
 fn flips_duplicates_and_replays_are_each_rejected_by_the_receiver() {
     let (mut faulty, mut other) = rig("tx.flip=0.1,tx.duplicate=0.1,tx.replay=0.1,seed=11");
     let got = run(&mut faulty, &mut other, 3000);
-    let mut receiver = Receiver::default();
+    let mut receiver = Receiver::owner(SESSION);
     let mut accepted_counters = Vec::new();
     for frame in got.iter().filter(|f| f.id() == command(1).id()) {
         if receiver.receive(frame.id(), frame.data()).is_ok() {
-            let decoded = protocol::decode_frame(frame.id(), frame.data()).unwrap();
-            accepted_counters.push(decoded.counter);
+            accepted_counters.push(counter(frame));
         }
     }
     let stats = faulty.tx_stats();
@@ -138,8 +146,9 @@ fn flips_duplicates_and_replays_are_each_rejected_by_the_receiver() {
         stats.flipped > 200 && stats.duplicated > 200 && stats.replayed > 200,
         "{stats:?}"
     );
+    // The command is authenticated: a flipped bit anywhere in it fails its MAC.
     assert_eq!(
-        u64::from(counters.get(RejectCause::Crc).raw()),
+        u64::from(counters.get(RejectCause::Unauthentic).raw()),
         stats.flipped
     );
     let sequence = u64::from(counters.get(RejectCause::Repeated).raw())
@@ -160,7 +169,20 @@ fn silencing_a_node_drops_all_of_its_frames() {
 #[test]
 fn a_flood_keeps_one_valid_sequence() {
     let (mut faulty, mut other) = rig("tx.flood=40");
-    let mut receiver = Receiver::default();
+    // Nothing to seal the flood in before the controller's announcement is heard.
+    faulty.send(&command(0)).unwrap();
+    faulty.end_cycle().unwrap();
+    assert_eq!(drain(&mut other), [command(0)]);
+    assert_eq!(faulty.tx_stats().flooded, 0);
+    let announce = AnyMessage::Announce(Announce {
+        version: WireVersion::THIS,
+        epoch: SESSION.epoch().unwrap(),
+    });
+    other
+        .send(&Sender::new().seal(&SESSION, &announce).unwrap())
+        .unwrap();
+    assert_eq!(drain(&mut faulty).len(), 1);
+    let mut receiver = Receiver::owner(SESSION);
     for _ in 0..25 {
         // The teleop's own counter stands still; the layer owns the sequence.
         faulty.send(&command(1)).unwrap();
@@ -191,7 +213,7 @@ fn received_frames_can_be_faulted_too() {
     let mut other = bus.endpoint();
     let mut seen = Vec::new();
     for cycle in 0..6_u32 {
-        other.send(&command(cycle as u16 + 1)).unwrap();
+        other.send(&command(cycle + 1)).unwrap();
         other.send(&sync(cycle)).unwrap();
         for frame in drain(&mut faulty) {
             if frame.id() == command(1).id() {
@@ -200,6 +222,6 @@ fn received_frames_can_be_faulted_too() {
         }
     }
     // Sent before SYNC c, received after SYNC c + 1: two cycle boundaries later.
-    let expected: Vec<_> = (1..6).map(|c| (c, command(c as u16))).collect();
+    let expected: Vec<_> = (1..6).map(|c| (c, command(c))).collect();
     assert_eq!(seen, expected);
 }
