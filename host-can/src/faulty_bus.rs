@@ -13,7 +13,8 @@
 use std::collections::{BTreeMap, VecDeque};
 use std::time::{Duration, Instant};
 
-use protocol::{decode_frame, AnyMessage, Frame, Key, MessageId, Session, TEST_KEY};
+use protocol::e2e::HEADER_LEN;
+use protocol::{decode_frame, protection_of, AnyMessage, Frame, Key, MessageId, Session, TEST_KEY};
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 
@@ -226,11 +227,14 @@ impl Injector {
         same.get(pick).copied()
     }
 
-    /// `frame` with one bit flipped inside the bytes its CRC covers, so that the flip is always
-    /// detectable (a flip in the zero padding would not be).
+    /// `frame` with one bit flipped inside the bytes its check value covers (the header and
+    /// the covered payload), so that the flip is always detectable: a flip in the zero padding,
+    /// or in an E-stop latch's token (its check covers action and source only), would not be.
     fn flip(&mut self, frame: Frame) -> Frame {
         let covered = MessageId::from_raw(frame.id())
-            .map_or(frame.data().len(), |id| id.layout().len)
+            .map_or(frame.data().len(), |id| {
+                HEADER_LEN + protection_of(id, frame.data()).1
+            })
             .min(frame.data().len());
         if covered == 0 {
             return frame;

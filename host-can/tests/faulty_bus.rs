@@ -8,8 +8,9 @@ use host_can::fault_plan::Faults;
 use host_can::faulty_bus::FaultyBus;
 use host_can::inproc_bus::{InprocBus, InprocEndpoint};
 use protocol::{
-    decode_frame, Announce, AnyMessage, BodyHeight, Epoch, Frame, Receiver, RejectCause, Sender,
-    Session, SpeedScale, Sync, TeleopCommand, TeleopMode, Tick, WireVersion, TEST_KEY,
+    decode_frame, Announce, AnyMessage, BodyHeight, EStop, Epoch, Frame, NodeId, Receiver,
+    RejectCause, Sender, Session, SpeedScale, Sync, TeleopCommand, TeleopMode, Tick, WireVersion,
+    TEST_KEY,
 };
 
 /// The controller's session, in which every frame of these tests is sealed.
@@ -156,6 +157,29 @@ fn flips_duplicates_and_replays_are_each_rejected_by_the_receiver() {
     assert_eq!(sequence, stats.duplicated + stats.replayed);
     // Nothing old was ever accepted: the accepted counters only go up.
     assert!(accepted_counters.windows(2).all(|w| w[1] > w[0]));
+}
+
+#[test]
+fn every_flipped_latch_is_rejected() {
+    // An E-stop latch's check covers its action and source, not the token after them: the
+    // layer flips only bits a receiver can detect.
+    let (mut faulty, mut other) = rig("tx.flip=1,seed=4");
+    let mut teleop = Sender::new();
+    for _ in 0..200 {
+        let latch = teleop
+            .seal(&SESSION, &AnyMessage::EStop(EStop::latch(NodeId::Teleop)))
+            .unwrap();
+        faulty.send(&latch).unwrap();
+    }
+    let mut receiver = Receiver::owner(SESSION);
+    let got = drain(&mut other);
+    assert_eq!((got.len(), faulty.tx_stats().flipped), (200, 200));
+    for frame in &got {
+        assert!(
+            receiver.receive(frame.id(), frame.data()).is_err(),
+            "{frame:?}"
+        );
+    }
 }
 
 #[test]
