@@ -9,7 +9,7 @@ use std::time::Duration;
 use criterion::{criterion_group, criterion_main, Criterion};
 use host_can::bus::Bus;
 use host_can::inproc_bus::InprocBus;
-use protocol::TeleopMode;
+use protocol::{Epoch, Session, TeleopMode, TEST_KEY};
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
 use sim_host::robot::imu::ImuNoise;
@@ -44,10 +44,15 @@ fn closed_loop(c: &mut Criterion) {
     let bus = InprocBus::new();
     let mut sim_bus = bus.endpoint();
     let mut teleop_bus = bus.endpoint();
-    let mut controller =
-        InprocController::new(firmware_config(250).expect("250 Hz"), bus.endpoint())
-            .expect("firmware");
-    // Drive forward on the wheels: the balance loop, the IMU and the wheel drive all work.
+    let session = Session::owned(TEST_KEY, Epoch::new(1));
+    let mut controller = InprocController::new(
+        firmware_config(250).expect("250 Hz"),
+        bus.endpoint(),
+        session,
+    )
+    .expect("firmware");
+    // Drive forward on the wheels: the balance loop, the IMU and the wheel drive all work. The
+    // operator hears the controller's announcement and status, and arms it (STOP, then W).
     let mut teleop = ScriptedTeleop::new(vec![PlanStep {
         at_us: 0,
         mode: TeleopMode::WheelForward,
@@ -68,6 +73,9 @@ fn closed_loop(c: &mut Criterion) {
                 &mut recorder,
                 options,
                 |cycle| {
+                    while let Some(frame) = teleop_bus.recv(Duration::ZERO)? {
+                        teleop.observe(&frame);
+                    }
                     for frame in teleop.frames(u64::from(cycle) * 4_000)? {
                         teleop_bus.send(&frame)?;
                     }
@@ -79,6 +87,12 @@ fn closed_loop(c: &mut Criterion) {
             .expect("cycle")
         })
     });
+    assert!(teleop.armed(), "the operator never armed the controller");
+    let state = controller.node().controller().state();
+    assert!(
+        matches!(state, firmware::control::fsm::State::Wheels(_)),
+        "measured in {state:?}, not on the wheels"
+    );
 }
 
 criterion_group!(benches, raw_step, closed_loop);

@@ -1,6 +1,6 @@
 //! The emulated drives and IMU on the in-process bus, driven by a hand-written controller that
-//! speaks only CAN frames: targets go out, feedback comes back, and the drives behave as real
-//! ones do on timeouts, corrupted frames and E-stops.
+//! speaks only CAN frames: it announces its session, targets go out, feedback comes back, and
+//! the drives behave as real ones do on timeouts, corrupted frames and E-stops.
 
 use std::cell::RefCell;
 use std::path::Path;
@@ -10,9 +10,9 @@ use std::time::Duration;
 use host_can::bus::Bus;
 use host_can::inproc_bus::{InprocBus, InprocEndpoint};
 use protocol::{
-    Angle, AnyMessage, Drive, DriveEnable, DriveFlags, DriveStatus, E2eCounter, EStop, EStopAction,
-    Frame, Joints, Leg, LegFeedback, LegTargets, NodeId, PerDrive, Receiver, Torque, WheelCommand,
-    WheelFeedback,
+    Angle, Announce, AnyMessage, Drive, DriveEnable, DriveFlags, DriveStatus, EStop, Epoch, Frame,
+    Joints, Leg, LegFeedback, LegTargets, NodeId, PerDrive, Receiver, ReleaseToken, Sender,
+    Session, Torque, WheelCommand, WheelFeedback, WireVersion, TEST_KEY,
 };
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
@@ -31,12 +31,16 @@ enum Plan {
     Silent,
 }
 
-/// A minimal controller: sends fixed targets, keeps the latest feedback and status.
+/// The test controller's session.
+const SESSION: Session = Session::owned(TEST_KEY, Epoch::new(1));
+
+/// A minimal controller: announces its session (at the first service, then every 25th),
+/// sends fixed targets, keeps the latest feedback and status.
 struct TestController {
     bus: InprocEndpoint,
     receiver: Receiver,
-    leg_counter: E2eCounter,
-    wheel_counter: E2eCounter,
+    sender: Sender,
+    services: u32,
     targets_rad: Joints<f32>,
     wheel_torque_nm: [f32; 2],
     plan: Plan,
@@ -54,9 +58,9 @@ impl TestController {
         let start = StartPose::standing();
         Self {
             bus,
-            receiver: Receiver::default(),
-            leg_counter: E2eCounter::default(),
-            wheel_counter: E2eCounter::default(),
+            receiver: Receiver::owner(SESSION),
+            sender: Sender::new(),
+            services: 0,
             targets_rad: start.leg_joint_rad.map(|a| a as f32),
             wheel_torque_nm: [0.0; 2],
             plan: Plan::Command,
@@ -70,7 +74,20 @@ impl TestController {
         }
     }
 
+    /// `message` sealed in the session with the next counter of its identifier.
+    fn seal(&mut self, message: AnyMessage) -> Frame {
+        self.sender.seal(&SESSION, &message).unwrap()
+    }
+
     fn service(&mut self) {
+        if self.services % 25 == 0 {
+            let announce = self.seal(AnyMessage::Announce(Announce {
+                version: WireVersion::THIS,
+                epoch: Epoch::new(1),
+            }));
+            self.bus.send(&announce).unwrap();
+        }
+        self.services += 1;
         while let Some(frame) = self.bus.recv(Duration::ZERO).unwrap() {
             let accepted = self
                 .receiver
@@ -96,17 +113,13 @@ impl TestController {
             self.bus.send(&frame).unwrap();
         }
         if self.plan == Plan::Command {
-            let legs = AnyMessage::LegTargets(LegTargets {
+            let legs = self.seal(AnyMessage::LegTargets(LegTargets {
                 enable: DriveEnable::Enabled,
                 position: self.targets_rad.map(Angle::saturating_from_si),
-            })
-            .encode(self.leg_counter.advance())
-            .unwrap();
-            let wheels = AnyMessage::WheelCommand(WheelCommand {
+            }));
+            let wheels = self.seal(AnyMessage::WheelCommand(WheelCommand {
                 torque: self.wheel_torque_nm.map(Torque::saturating_from_si),
-            })
-            .encode(self.wheel_counter.advance())
-            .unwrap();
+            }));
             for frame in [legs, wheels] {
                 self.bus.send(&frame).unwrap();
                 self.sent.push(frame);
@@ -129,7 +142,9 @@ fn setup() -> (Simulator, InprocEndpoint, Rc<RefCell<TestController>>) {
     (sim, sim_bus, controller)
 }
 
-/// Runs `cycles` lockstep cycles; returns how many cycles missed their command.
+/// Runs `cycles` lockstep cycles; returns how many cycles missed their command. The first
+/// run's first cycle is the one in which the simulator hears the announcement: it sends
+/// nothing and does not step.
 fn run(
     sim: &mut Simulator,
     bus: &mut InprocEndpoint,
@@ -184,7 +199,7 @@ fn leg_drives_servo_to_the_frames_targets_and_report_every_cycle() {
         "{} feedback frames",
         c.feedback_frames
     );
-    assert_eq!(c.receiver.counters().rejected.map(|n| n.raw()), [0; 7]);
+    assert_eq!(c.receiver.counters().rejected.map(|n| n.raw()), [0; 10]);
     assert_eq!(c.receiver.counters().lost.raw(), 0);
     let fl = c.leg_feedback[0].expect("front-left feedback");
     let got = [fl.position[0].si(), fl.position[2].si()];
@@ -280,12 +295,10 @@ fn corrupted_and_replayed_commands_are_rejected_counted_and_never_applied() {
     for leg in Leg::ALL {
         evil_targets.leg_mut(leg)[1] += 0.5;
     }
-    let evil = AnyMessage::LegTargets(LegTargets {
+    let evil = ctl.borrow_mut().seal(AnyMessage::LegTargets(LegTargets {
         enable: DriveEnable::Enabled,
         position: evil_targets.map(Angle::saturating_from_si),
-    })
-    .encode(ctl.borrow_mut().leg_counter.advance())
-    .unwrap();
+    }));
     let mut flipped = evil.data().to_vec();
     flipped[7] ^= 0x10;
     let corrupted = Frame::new(evil.id(), &flipped).unwrap();
@@ -317,15 +330,10 @@ fn an_e_stop_frame_stops_every_drive_until_it_is_cleared() {
     let (mut sim, mut bus, ctl) = setup();
     ctl.borrow_mut().wheel_torque_nm = [3.0, 3.0];
     run(&mut sim, &mut bus, &ctl, 25, |_| {});
-    let estop = |action, counter| {
-        AnyMessage::EStop(EStop {
-            action,
-            source: NodeId::Tool,
-        })
-        .encode(counter)
-        .unwrap()
-    };
-    ctl.borrow_mut().extra = vec![estop(EStopAction::Latch, 0)];
+    // The drives act on any authentic release (the controller checks its token).
+    let estop = |estop| ctl.borrow_mut().seal(AnyMessage::EStop(estop));
+    let latch = estop(EStop::latch(NodeId::Tool));
+    ctl.borrow_mut().extra = vec![latch];
     let mut stopped_within_cycles = None;
     let mut n = 0;
     run(&mut sim, &mut bus, &ctl, 50, |s| {
@@ -347,7 +355,8 @@ fn an_e_stop_frame_stops_every_drive_until_it_is_cleared() {
     for status in ctl.borrow().drive_status {
         assert!(status.unwrap().flags.contains(DriveFlags::ESTOP));
     }
-    ctl.borrow_mut().extra = vec![estop(EStopAction::Clear, 1)];
+    let release = estop(EStop::release(NodeId::Tool, ReleaseToken::new(1)));
+    ctl.borrow_mut().extra = vec![release];
     run(&mut sim, &mut bus, &ctl, 30, |_| {});
     assert_eq!(sim.hardware().wheel_torque_nm(sim.now_us()), [3.0, 3.0]);
     assert!((0..4).all(|leg| sim.physics().leg_enabled(leg)));

@@ -1,18 +1,34 @@
-//! The emulated drives enforce their own ratings whatever the wire says: a CRC-valid command
+//! The emulated drives enforce their own ratings whatever the wire says: an authentic command
 //! beyond them is clamped, applied within them, and counted.
 
-use protocol::{Angle, AnyMessage, DriveEnable, Joints, Leg, LegTargets, Torque, WheelCommand};
+use protocol::{
+    Angle, Announce, AnyMessage, DriveEnable, Epoch, Frame, Joints, Leg, LegTargets, Session,
+    Torque, WheelCommand, WireVersion, TEST_KEY,
+};
 use sim_host::robot::leg_drive::LegDrive;
 use sim_host::robot::wheel_drive::{WheelDrive, WHEEL_PEAK_TORQUE_NM};
 
+/// The controller's session, which the drives join on its announcement.
+const SESSION: Session = Session::owned(TEST_KEY, Epoch::new(1));
+
+fn announce() -> Frame {
+    AnyMessage::Announce(Announce {
+        version: WireVersion::THIS,
+        epoch: Epoch::new(1),
+    })
+    .encode(&SESSION, 0)
+    .unwrap()
+}
+
 #[test]
 fn a_wheel_command_above_the_rating_is_applied_at_the_rating_and_counted() {
-    let mut drive = WheelDrive::default();
-    let command = |torque_nm: [f32; 2], counter: u16| {
+    let mut drive = WheelDrive::new(TEST_KEY);
+    drive.on_frame(0, &announce());
+    let command = |torque_nm: [f32; 2], counter: u32| {
         AnyMessage::WheelCommand(WheelCommand {
             torque: torque_nm.map(Torque::saturating_from_si),
         })
-        .encode(counter)
+        .encode(&SESSION, counter)
         .unwrap()
     };
     drive.on_frame(0, &command([300.0, -300.0], 0));
@@ -40,8 +56,9 @@ fn leg_targets_outside_the_joint_range_are_held_at_the_range_and_counted() {
         [deg(-110.0), deg(15.0)],
         [deg(-40.0), deg(40.0)],
     ];
-    let mut drive = LegDrive::new(Leg::Fl, range);
-    let targets = |fl_deg: [f64; 4], counter: u16| {
+    let mut drive = LegDrive::new(Leg::Fl, range, TEST_KEY);
+    drive.on_frame(0, &announce());
+    let targets = |fl_deg: [f64; 4], counter: u32| {
         let mut position = Joints::splat(Angle::saturating_from_si(0.0));
         for (slot, d) in position.leg_mut(Leg::Fl).iter_mut().zip(fl_deg) {
             *slot = Angle::saturating_from_si(deg(d) as f32);
@@ -50,7 +67,7 @@ fn leg_targets_outside_the_joint_range_are_held_at_the_range_and_counted() {
             enable: DriveEnable::Enabled,
             position,
         })
-        .encode(counter)
+        .encode(&SESSION, counter)
         .unwrap()
     };
     drive.on_frame(0, &targets([0.0, 80.0, 60.0, -90.0], 0));
