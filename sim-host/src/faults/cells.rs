@@ -107,19 +107,22 @@ pub(super) fn flips_and_replays(
         ),
     };
     // Each drive checks the commands meant for it: every bad LegTargets must be refused by all
-    // four leg drives, every bad WheelCommand by the wheel drive.
+    // four leg drives, every bad WheelCommand by the wheel drive; and every drive checks the
+    // controller's session announcements, so a bad one is refused by all five.
     let hardware = rig.sim().hardware();
     let bad_legs = rig.sim_bus().rx_bad_frames(MessageId::LegTargets.raw());
     let bad_wheels = rig.sim_bus().rx_bad_frames(MessageId::WheelCommand.raw());
+    let bad_announce = rig.sim_bus().rx_bad_frames(MessageId::Announce.raw());
     let legs_refused: Vec<u64> = hardware
         .legs()
         .iter()
         .map(|leg| u64::from(leg.core().rejected()))
         .collect();
     let wheels_refused = u64::from(hardware.wheel().core().rejected());
-    let drives_exact = legs_refused.iter().all(|&n| n == bad_legs) && wheels_refused == bad_wheels;
+    let drives_exact = legs_refused.iter().all(|&n| n == bad_legs + bad_announce)
+        && wheels_refused == bad_wheels + bad_announce;
     let drives_bad: u64 = legs_refused.iter().sum::<u64>() + wheels_refused;
-    let drives_sent = 4 * bad_legs + bad_wheels;
+    let drives_sent = 4 * bad_legs + bad_wheels + 5 * bad_announce;
     let records = rig.records();
     let non_finite = records
         .iter()
@@ -155,8 +158,11 @@ pub(super) fn flood(model: &Path) -> Result<CellResult, SessionError> {
     let flooded = rig.teleop_fault_stats().flooded;
     let limited = rig.firmware_rejected(RejectCause::RateLimited);
     let missed = rig.stats().missed_cycles;
+    // From the first cycle that stepped: before it the simulator has not joined the session
+    // and sends no feedback yet.
     let stale = records
         .iter()
+        .skip_while(|r| !r.stepped)
         .any(|r| r.faults.contains(FaultFlags::FEEDBACK_TIMEOUT));
     let still = records.last().is_some_and(|r| Motion::Trot.moving(r.state));
     let cycles = records.len() as u64;

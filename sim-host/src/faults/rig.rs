@@ -59,8 +59,13 @@ pub struct CycleRecord {
     pub timed_out: PerDrive<bool>,
     /// Per drive: E-stop latched.
     pub estop: PerDrive<bool>,
-    /// Whether the controller's wheel command arrived this cycle.
+    /// Whether the controller's wheel command arrived this cycle (false in a cycle that did
+    /// not step).
     pub commanded: bool,
+    /// Whether the physics stepped this cycle: false until the simulator has joined the
+    /// controller's session (heard its announcement), when nothing is sent and time stands
+    /// still.
+    pub stepped: bool,
 }
 
 impl CycleRecord {
@@ -156,7 +161,7 @@ impl Rig {
             }
             Ok(())
         };
-        lockstep::cycle(
+        let stepped = lockstep::cycle(
             &mut self.sim,
             &mut self.sim_bus,
             &mut self.recorder,
@@ -166,7 +171,10 @@ impl Rig {
         )?;
         self.time_us += PERIOD_US;
         self.count_rejections();
-        let record = self.record(self.stats.missed_cycles == missed_before);
+        let record = self.record(
+            stepped,
+            stepped && self.stats.missed_cycles == missed_before,
+        );
         self.records.push(record);
         Ok(())
     }
@@ -204,7 +212,7 @@ impl Rig {
             .unwrap_or(0)
     }
 
-    fn record(&self, commanded: bool) -> CycleRecord {
+    fn record(&self, stepped: bool, commanded: bool) -> CycleRecord {
         let physics = self.sim.physics();
         let torso = physics.torso();
         let now_us = self.sim.now_us();
@@ -233,6 +241,7 @@ impl Rig {
             timed_out: cores.map(|c| c.timed_out(now_us)),
             estop: cores.map(DriveCore::estop),
             commanded,
+            stepped,
         }
     }
 
