@@ -86,12 +86,11 @@ impl ImuNode {
         for (value, bias) in force.iter_mut().zip(n.accel_bias_m_s2) {
             *value += bias + self.gaussian(n.accel_std_m_s2);
         }
-        let message = AnyMessage::Imu(Imu {
+        AnyMessage::Imu(Imu {
             orientation: quat.map(|c| QuatComponent::saturating_from_si(c as f32)),
             angular_rate: rate.map(|r| AngularRate::saturating_from_si(r as f32)),
             acceleration: force.map(|a| Acceleration::saturating_from_si(a as f32)),
-        });
-        message
+        })
     }
 }
 
