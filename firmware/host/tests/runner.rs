@@ -8,14 +8,30 @@ use std::time::{Duration, Instant};
 use firmware_host::runner::{self, Clock, RunnerConfig};
 use host_can::bus::{Bus, BusError};
 use host_can::inproc_bus::InprocBus;
-use protocol::{AnyMessage, DriveEnable, E2eCounter, MessageId, Receiver, Sync, Tick};
+use protocol::{
+    AnyMessage, DriveEnable, Epoch, MessageId, Receiver, Sender, Session, Sync, Tick, TEST_KEY,
+};
 
-fn sync(tick: u32, counter: &mut E2eCounter) -> protocol::Frame {
-    AnyMessage::Sync(Sync {
+/// The session the runner under test opens.
+const SESSION: Session = Session::owned(TEST_KEY, Epoch::new(1));
+
+/// A runner configuration in [`SESSION`], nothing latched.
+fn config(clock: Clock, max_ticks: Option<u64>, idle_timeout: Option<Duration>) -> RunnerConfig {
+    RunnerConfig {
+        session: SESSION,
+        latched: false,
+        clock,
+        control_hz: 250,
+        max_ticks,
+        idle_timeout,
+    }
+}
+
+fn sync(tick: u32, sender: &mut Sender, session: &Session) -> protocol::Frame {
+    let sync = AnyMessage::Sync(Sync {
         tick: Tick::from_raw(tick).unwrap(),
-    })
-    .encode(counter.advance())
-    .unwrap()
+    });
+    sender.seal(session, &sync).unwrap()
 }
 
 #[test]
@@ -28,20 +44,25 @@ fn lockstep_answers_every_sync_with_a_wheel_command_then_stops_the_drives() {
     let runner = std::thread::spawn(move || {
         runner::run(
             &mut firmware_bus,
-            RunnerConfig {
-                clock: Clock::Lockstep,
-                control_hz: 250,
-                max_ticks: Some(50),
-                idle_timeout: Some(Duration::from_secs(10)),
-            },
+            config(Clock::Lockstep, Some(50), Some(Duration::from_secs(10))),
             &runner_stop,
+            None,
         )
     });
-    let mut counter = E2eCounter::default();
-    let mut rx = Receiver::default();
+    // The simulator joins the session the runner announces while it waits for SYNC.
+    let mut rx = Receiver::member(TEST_KEY);
+    let announce = sim
+        .recv(Duration::from_secs(5))
+        .unwrap()
+        .expect("the session announced");
+    let accepted = rx.receive(announce.id(), announce.data()).unwrap();
+    assert!(matches!(accepted.message, AnyMessage::Announce(_)));
+    assert_eq!(rx.session().epoch(), SESSION.epoch());
+    let session = *rx.session();
+    let mut clock = Sender::new();
     let mut commands = 0;
     for tick in 0..50 {
-        sim.send(&sync(tick, &mut counter)).unwrap();
+        sim.send(&sync(tick, &mut clock, &session)).unwrap();
         // Each SYNC is answered with a wheel command before the next one is sent.
         loop {
             let frame = sim
@@ -58,7 +79,7 @@ fn lockstep_answers_every_sync_with_a_wheel_command_then_stops_the_drives() {
     }
     let stats = runner.join().unwrap().unwrap();
     assert_eq!((commands, stats.ticks), (50, 50));
-    assert_eq!(stats.rejected, [0; 7]);
+    assert_eq!(stats.rejected, [0; 10]);
     // The last frames: legs torque-free and zero wheel torque, accepted in sequence.
     let mut last_legs = None;
     while let Some(frame) = sim.recv(Duration::from_millis(100)).unwrap() {
@@ -77,13 +98,9 @@ fn a_quiet_bus_in_lockstep_is_an_error_naming_the_simulator() {
     let mut firmware_bus = bus.endpoint();
     let err = runner::run(
         &mut firmware_bus,
-        RunnerConfig {
-            clock: Clock::Lockstep,
-            control_hz: 250,
-            max_ticks: None,
-            idle_timeout: Some(Duration::from_millis(200)),
-        },
+        config(Clock::Lockstep, None, Some(Duration::from_millis(200))),
         &AtomicBool::new(false),
+        None,
     )
     .unwrap_err();
     assert!(err.to_string().contains("simulator"), "{err}");
@@ -99,15 +116,13 @@ fn heartbeats_without_sync_still_end_in_the_idle_timeout_and_a_stop_is_heard() {
     let done = Arc::new(AtomicBool::new(false));
     let talking = Arc::clone(&done);
     let talker = std::thread::spawn(move || {
-        let mut counter = E2eCounter::default();
+        let mut sender = Sender::new();
         let mut uptime_ms = 0;
         while !talking.load(Ordering::Relaxed) {
             let beat = AnyMessage::TeleopHeartbeat(protocol::TeleopHeartbeat {
                 uptime: protocol::Millis::from_raw(uptime_ms).unwrap(),
             });
-            teleop
-                .send(&beat.encode(counter.advance()).unwrap())
-                .unwrap();
+            teleop.send(&sender.seal(&SESSION, &beat).unwrap()).unwrap();
             uptime_ms += 20;
             std::thread::sleep(Duration::from_millis(20));
         }
@@ -115,13 +130,9 @@ fn heartbeats_without_sync_still_end_in_the_idle_timeout_and_a_stop_is_heard() {
     let started = Instant::now();
     let result = runner::run(
         &mut firmware_bus,
-        RunnerConfig {
-            clock: Clock::Lockstep,
-            control_hz: 250,
-            max_ticks: None,
-            idle_timeout: Some(Duration::from_millis(300)),
-        },
+        config(Clock::Lockstep, None, Some(Duration::from_millis(300))),
         &AtomicBool::new(false),
+        None,
     );
     let waited = started.elapsed();
     done.store(true, Ordering::Relaxed);
@@ -140,13 +151,9 @@ fn heartbeats_without_sync_still_end_in_the_idle_timeout_and_a_stop_is_heard() {
     });
     let stats = runner::run(
         &mut bus.endpoint(),
-        RunnerConfig {
-            clock: Clock::Lockstep,
-            control_hz: 250,
-            max_ticks: None,
-            idle_timeout: None,
-        },
+        config(Clock::Lockstep, None, None),
         &stop,
+        None,
     )
     .unwrap();
     let asked = stopper.join().unwrap();
@@ -165,13 +172,9 @@ fn on_the_wall_clock_it_keeps_its_own_time() {
     let mut firmware_bus = bus.endpoint();
     let stats = runner::run(
         &mut firmware_bus,
-        RunnerConfig {
-            clock: Clock::Wall,
-            control_hz: 250,
-            max_ticks: Some(25),
-            idle_timeout: None,
-        },
+        config(Clock::Wall, Some(25), None),
         &AtomicBool::new(false),
+        None,
     )
     .unwrap();
     assert_eq!(stats.ticks, 25);
@@ -227,13 +230,9 @@ fn a_stalled_wall_clock_runner_loses_the_missed_ticks_instead_of_bunching_them_u
     };
     let stats = runner::run(
         &mut stalling,
-        RunnerConfig {
-            clock: Clock::Wall,
-            control_hz: 250,
-            max_ticks: Some(20),
-            idle_timeout: None,
-        },
+        config(Clock::Wall, Some(20), None),
         &AtomicBool::new(false),
+        None,
     )
     .unwrap();
     assert_eq!(stats.ticks, 20);
@@ -278,5 +277,75 @@ fn the_wall_clock_schedule_keeps_going_past_two_to_the_32_periods() {
     assert_eq!(
         slot_start(Duration::from_secs(1), u64::MAX).as_secs(),
         u64::MAX
+    );
+}
+
+#[test]
+fn the_state_file_gives_each_start_a_greater_epoch_and_keeps_a_latch_across_restarts() {
+    use firmware_host::state::StateFile;
+    use protocol::{EStop, NodeId};
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("runner-state");
+    let _ = std::fs::remove_dir_all(&dir);
+    let path = dir.join("firmware-host.toml");
+    let (_, first, latched) = StateFile::start(&path, None).unwrap();
+    assert_eq!((first.raw(), latched), (1, false));
+    let (_, second, _) = StateFile::start(&path, None).unwrap();
+    assert_eq!(second.raw(), 2);
+    // After a lost state file, `--epoch` sets a floor.
+    let (mut state, third, _) = StateFile::start(&path, Some(Epoch::new(10))).unwrap();
+    assert_eq!(third.raw(), 10);
+
+    // A latch heard in this run is written to the file...
+    let bus = InprocBus::new();
+    let mut firmware_bus = bus.endpoint();
+    let mut panel = bus.endpoint();
+    let latch = Sender::new()
+        .seal(
+            &Session::unjoined(TEST_KEY),
+            &AnyMessage::EStop(EStop::latch(NodeId::Tool)),
+        )
+        .unwrap();
+    panel.send(&latch).unwrap();
+    let session = Session::owned(TEST_KEY, third);
+    let wall = |latched| RunnerConfig {
+        session,
+        latched,
+        ..config(Clock::Wall, Some(5), None)
+    };
+    runner::run(
+        &mut firmware_bus,
+        wall(false),
+        &AtomicBool::new(false),
+        Some(&mut state),
+    )
+    .unwrap();
+    // ...and the next start, in a new session, begins latched.
+    let (_, fourth, latched) = StateFile::start(&path, None).unwrap();
+    assert_eq!((fourth.raw(), latched), (11, true));
+    while panel.recv(Duration::ZERO).unwrap().is_some() {}
+    let mut rx = Receiver::member(TEST_KEY);
+    runner::run(
+        &mut firmware_bus,
+        RunnerConfig {
+            session: Session::owned(TEST_KEY, fourth),
+            max_ticks: Some(25),
+            ..wall(true)
+        },
+        &AtomicBool::new(false),
+        None,
+    )
+    .unwrap();
+    let mut modes = Vec::new();
+    while let Some(frame) = panel.recv(Duration::ZERO).unwrap() {
+        if let AnyMessage::ControllerStatus(status) =
+            rx.receive(frame.id(), frame.data()).unwrap().message
+        {
+            modes.push(status.mode);
+        }
+    }
+    assert_eq!(rx.session().epoch(), Some(fourth));
+    assert!(
+        !modes.is_empty() && modes.iter().all(|m| *m == protocol::ControllerMode::EStop),
+        "{modes:?}"
     );
 }
