@@ -202,7 +202,7 @@ mod tests {
         use protocol::{AnyMessage, Torque, WheelCommand};
         let torque = [left, right].map(|raw| Torque::from_raw(raw).unwrap());
         AnyMessage::WheelCommand(WheelCommand { torque })
-            .encode(3)
+            .encode(&pil_session(), 3)
             .unwrap()
             .data()
             .to_vec()
