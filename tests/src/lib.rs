@@ -39,7 +39,8 @@ pub fn program(name: &str) -> PathBuf {
     }
 }
 
-/// A `vcan` interface of this test, removed when dropped.
+/// A `vcan` interface of this test, removed when dropped, with the state file of the
+/// controller on it (see [`Vcan::state_file`]).
 #[derive(Debug)]
 pub struct Vcan {
     name: String,
@@ -83,12 +84,23 @@ impl Vcan {
                 panic!("cannot set up {name}: {e}");
             }
         }
-        Self { name }
+        let bus = Self { name };
+        // A state file left by an earlier run of the same name would start the controller in
+        // its epoch, or latched.
+        let _ = std::fs::remove_file(bus.state_file());
+        bus
     }
 
     /// The interface name.
     pub fn name(&self) -> &str {
         &self.name
+    }
+
+    /// Where the controller on this bus keeps its session epoch and E-stop latch
+    /// (`firmware-host --state-file`): a firmware restarted on the same bus opens a greater
+    /// epoch, as the real controller does. Removed with the interface.
+    pub fn state_file(&self) -> PathBuf {
+        std::env::temp_dir().join(format!("hil-{}-firmware-host.toml", self.name))
     }
 }
 
@@ -103,6 +115,7 @@ impl Drop for Vcan {
         let _ = Command::new("ip")
             .args(["link", "del", "dev", &self.name])
             .status();
+        let _ = std::fs::remove_file(self.state_file());
     }
 }
 
@@ -184,8 +197,15 @@ pub fn out_dir(test: &str) -> PathBuf {
     dir
 }
 
-/// The firmware in lockstep on `bus`.
+/// The firmware in lockstep on `bus`, keeping its state in the bus's state file.
 pub fn firmware(bus: &Vcan) -> Process {
+    firmware_with_state(bus, &bus.state_file())
+}
+
+/// The firmware in lockstep on `bus`, keeping its state in `state` (another bus's state file:
+/// the same controller, restarted on another bus).
+pub fn firmware_with_state(bus: &Vcan, state: &Path) -> Process {
+    let state = state.to_string_lossy();
     Process::start(
         "firmware-host",
         &[
@@ -195,12 +215,15 @@ pub fn firmware(bus: &Vcan) -> Process {
             "lockstep",
             "--idle-timeout-s",
             "20",
+            "--state-file",
+            &state,
         ],
     )
 }
 
 /// The firmware on its own wall clock at 250 Hz on `bus`, as on the microcontroller.
 pub fn firmware_on_wall_clock(bus: &Vcan) -> Process {
+    let state = bus.state_file();
     Process::start(
         "firmware-host",
         &[
@@ -210,6 +233,8 @@ pub fn firmware_on_wall_clock(bus: &Vcan) -> Process {
             "wall",
             "--control-hz",
             "250",
+            "--state-file",
+            &state.to_string_lossy(),
         ],
     )
 }
@@ -348,6 +373,19 @@ pub fn read_telemetry(path: &Path) -> Vec<(f64, [f64; 2], String)> {
             )
         })
         .collect()
+}
+
+/// The controller's session as its announcement in `frames` gives it (the last one), with the
+/// test key: what a keyholder's tool seals its frames in. `None` before an announcement.
+pub fn announced_session(frames: &[(f64, protocol::Frame)]) -> Option<protocol::Session> {
+    frames.iter().rev().find_map(|(_, frame)| {
+        match protocol::decode_frame(frame.id(), frame.data()).map(|d| d.message) {
+            Ok(protocol::AnyMessage::Announce(announce)) => {
+                Some(protocol::Session::owned(protocol::TEST_KEY, announce.epoch))
+            }
+            _ => None,
+        }
+    })
 }
 
 /// Polls the `candump` log at `path` every 20 ms until `seen` holds for its frames, at most

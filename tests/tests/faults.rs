@@ -15,7 +15,8 @@ use host_can::faulty_bus::FaultyBus;
 use host_can::socketcan_bus::SocketCanBus;
 use protocol::{
     decode_frame, AnyMessage, BodyHeight, ControllerMode, FaultFlags, Frame, MessageId, Millis,
-    NodeId, Receiver, RejectCause, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode,
+    NodeId, Receiver, RejectCause, Sender, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode,
+    TEST_KEY,
 };
 
 /// Whether the controller sent `frame`.
@@ -64,11 +65,17 @@ fn corrupted_and_replayed_feedback_over_vcan_is_refused_frame_for_frame_and_the_
     // An independent receiver over exactly what the kernel carried must refuse what the
     // firmware refused: at each of the firmware's RejectCounters frames, its counts equal ours
     // as of the SYNC it answered (frames after that SYNC are not yet read by the firmware).
+    // Ours joins the session on the controller's announcement, as any node does.
     let frames = read_candump(&log);
-    let mut ours = Receiver::default();
+    let mut ours = Receiver::member(TEST_KEY);
     let mut at_sync = *ours.counters();
     let mut compared = 0;
     for (_, frame) in &frames {
+        if frame.id() == MessageId::Announce.raw() {
+            ours.receive(frame.id(), frame.data())
+                .expect("the controller's announcement");
+            continue;
+        }
         if from_controller(frame) {
             if let Ok(AnyMessage::RejectCounters(theirs)) =
                 decode_frame(frame.id(), frame.data()).map(|d| d.message)
@@ -165,28 +172,42 @@ fn teleop_command(mode: TeleopMode) -> AnyMessage {
     })
 }
 
-/// A babbling operator: heartbeats and L at 50 Hz as a teleop sends them, plus its last command
-/// repeated by the fault layer, counters in sequence, at `rate_hz` in all, for `seconds`.
+/// A babbling operator with the key: heartbeats and L at 50 Hz as a teleop sends them, plus its
+/// last command repeated by the fault layer, counters in sequence, at `rate_hz` in all, for
+/// `seconds`. It joins the session the controller announces first (the fault layer follows
+/// the announcement too, to seal its copies), and keeps reading the bus meanwhile.
 fn flood(ifname: &str, rate_hz: f64, seconds: f64) -> u64 {
     let socket = SocketCanBus::open(ifname).expect("open the vcan for the flood");
     let plan: Faults = "tx.flood=1".parse().expect("plan");
     let mut bus = FaultyBus::new(socket, &plan);
+    let mut link = Receiver::member(TEST_KEY);
+    let joining = Instant::now();
+    while link.session().epoch().is_none() {
+        assert!(
+            joining.elapsed() < Duration::from_secs(5),
+            "the flood heard no announcement"
+        );
+        if let Some(frame) = bus.recv(Duration::from_millis(20)).expect("receive") {
+            let _ = link.receive(frame.id(), frame.data());
+        }
+    }
+    let session = *link.session();
+    let mut teleop = Sender::new();
     let started = Instant::now();
-    let mut heartbeat = protocol::E2eCounter::default();
     let mut sent_flood = 0_u64;
     let mut next_heartbeat = Duration::ZERO;
     while started.elapsed().as_secs_f64() < seconds {
+        while bus.recv(Duration::ZERO).expect("receive").is_some() {}
         let elapsed = started.elapsed();
         if elapsed >= next_heartbeat {
             let uptime_ms = u32::try_from(elapsed.as_millis()).unwrap_or(u32::MAX);
             let beat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
                 uptime: Millis::from_raw(uptime_ms).unwrap_or(Millis::saturating_from_si(0.0)),
-            })
-            .encode(heartbeat.advance())
-            .expect("heartbeat");
+            });
+            let beat = teleop.seal(&session, &beat).expect("heartbeat");
             bus.send(&beat).expect("send heartbeat");
-            let command = teleop_command(TeleopMode::TrotForward)
-                .encode(1)
+            let command = teleop
+                .seal(&session, &teleop_command(TeleopMode::TrotForward))
                 .expect("command");
             bus.send(&command).expect("send command");
             next_heartbeat += Duration::from_millis(20);

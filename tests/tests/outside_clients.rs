@@ -8,10 +8,10 @@
 use std::time::Duration;
 
 use hil_tests::{
-    candump, cansend, firmware, one_at_a_time, out_dir, read_candump, read_telemetry, start_sim,
-    wait_for_log, workspace, Process, Vcan,
+    announced_session, candump, cansend, firmware, firmware_with_state, one_at_a_time, out_dir,
+    read_candump, read_telemetry, start_sim, wait_for_log, workspace, Process, Vcan,
 };
-use protocol::{decode_frame, AnyMessage, ControllerMode, EStop, EStopAction, NodeId};
+use protocol::{classic_latch, decode_frame, AnyMessage, ControllerMode, NodeId, RejectCause};
 
 #[test]
 fn an_e_stop_from_cansend_stops_every_drive_within_one_control_period() {
@@ -36,12 +36,8 @@ fn an_e_stop_from_cansend_stops_every_drive_within_one_control_period() {
         })
     });
     assert!(driving, "the robot never drove forward");
-    let latch = AnyMessage::EStop(EStop {
-        action: EStopAction::Latch,
-        source: NodeId::Tool,
-    })
-    .encode(0)
-    .unwrap();
+    // The constant latch an E-stop panel sends: classic CAN, bound to no session.
+    let latch = classic_latch(NodeId::Tool, 0).unwrap();
     cansend(&bus, &latch);
     assert!(sim.wait(Duration::from_secs(600)).success());
     let _ = fw.terminate();
@@ -153,14 +149,16 @@ fn candump_records_a_bus_on_which_every_frame_decodes() {
     println!("candump -L: {} frames, ids {ids:03X?}", frames.len());
 }
 
-/// The firmware and the simulator in lockstep, paced to at most real time (`--pace 1`), so that
-/// the operator's frames, replayed at their recorded wall-clock times, land at about the same
-/// simulated times as when they were recorded. Unpaced, the simulated time a frame lands at
-/// depends on how fast the emulated VM happens to run each time, and the replay drove 1.2–2.2 m
-/// of the recorded 2.3 m. (The wall clock mode would tie them too, but it steps without the
-/// controller's command when a descheduled process misses a cycle; paced lockstep only slows.)
-fn lockstep_pair(bus: &Vcan, out: &std::path::Path, extra: &[&str]) -> (Process, Process) {
-    let fw = firmware(bus);
+/// The firmware (keeping its state in `state`) and the simulator in lockstep, paced to at most
+/// real time (`--pace 1`), so that frames replayed at their recorded wall-clock times land at
+/// about the same simulated times as when they were recorded.
+fn lockstep_pair(
+    bus: &Vcan,
+    state: &std::path::Path,
+    out: &std::path::Path,
+    extra: &[&str],
+) -> (Process, Process) {
+    let fw = firmware_with_state(bus, state);
     let mut args = vec!["--duration-s", "8", "--pace", "1"];
     args.extend_from_slice(extra);
     let sim = start_sim(bus.name(), out, &args);
@@ -168,7 +166,7 @@ fn lockstep_pair(bus: &Vcan, out: &std::path::Path, extra: &[&str]) -> (Process,
 }
 
 #[test]
-fn canplayer_replays_a_recorded_teleop_session_and_the_robot_repeats_it() {
+fn canplayer_replaying_a_recorded_teleop_session_into_the_restarted_controller_moves_nothing() {
     let _alone = one_at_a_time();
     // Record: a scripted operator folds and drives forward; candump records the bus.
     let first = Vcan::new();
@@ -176,7 +174,13 @@ fn canplayer_replays_a_recorded_teleop_session_and_the_robot_repeats_it() {
     let dump = candump(&first, &log);
     std::thread::sleep(Duration::from_millis(200));
     let out1 = out_dir("session-run");
-    let (fw, sim) = lockstep_pair(&first, &out1, &["--drive", "0:fold", "--drive", "3:W"]);
+    let state = first.state_file();
+    let (fw, sim) = lockstep_pair(
+        &first,
+        &state,
+        &out1,
+        &["--drive", "0:fold", "--drive", "3:W"],
+    );
     assert!(sim.wait(Duration::from_secs(600)).success());
     let _ = fw.terminate();
     std::thread::sleep(Duration::from_millis(100));
@@ -196,34 +200,73 @@ fn canplayer_replays_a_recorded_teleop_session_and_the_robot_repeats_it() {
     let session = out_dir("teleop-only").with_extension("log");
     std::fs::write(&session, teleop.join("\n") + "\n").unwrap();
 
-    // Replay on a fresh bus with a fresh firmware and simulator, and nobody else driving.
+    // Replay on a fresh bus into the same controller restarted (its state file gives it the
+    // next session epoch), with a fresh simulator and nobody else driving: the recording
+    // belongs to the earlier session, so every replayed command and heartbeat fails its
+    // authentication, is counted, and moves nothing.
     let second = Vcan::new();
+    let log2 = out_dir("replay").with_extension("log");
+    let dump = candump(&second, &log2);
     let out2 = out_dir("replay-run");
-    let (fw, sim) = lockstep_pair(&second, &out2, &[]);
+    let (fw, sim) = lockstep_pair(&second, &state, &out2, &[]);
     std::thread::sleep(Duration::from_millis(300));
     let mapping = format!("{}={}", second.name(), first.name());
     let player = Process::start("canplayer", &["-I", &session.to_string_lossy(), &mapping]);
     assert!(player.wait(Duration::from_secs(120)).success());
     assert!(sim.wait(Duration::from_secs(600)).success());
     let _ = fw.terminate();
+    std::thread::sleep(Duration::from_millis(100));
+    let _ = dump.terminate();
 
-    let summary = |dir: &std::path::Path| {
-        let rows = read_telemetry(&dir.join("telemetry.csv"));
-        let drove = rows.iter().any(|(.., mode)| mode == "WheelForward");
-        (drove, rows.len())
-    };
     let moved = |dir: &std::path::Path| {
         let text = std::fs::read_to_string(dir.join("telemetry.csv")).unwrap();
         let last = text.lines().last().unwrap().to_owned();
         last.split(',').nth(1).unwrap().parse::<f64>().unwrap()
     };
     let (recorded, replayed) = (moved(&out1), moved(&out2));
-    println!("recorded session: {recorded:.3} m forward; replayed: {replayed:.3} m");
-    assert!(summary(&out2).0, "the replayed robot never drove forward");
+    let frames = read_candump(&log2);
+    let epochs = [
+        announced_session(&read_candump(&log)),
+        announced_session(&frames),
+    ]
+    .map(|s| s.and_then(|s| s.epoch()).map(|e| e.raw()));
+    let refused = frames
+        .iter()
+        .rev()
+        .find_map(
+            |(_, f)| match decode_frame(f.id(), f.data()).map(|d| d.message) {
+                Ok(AnyMessage::RejectCounters(c)) => Some(c.get(RejectCause::Unauthentic).raw()),
+                _ => None,
+            },
+        )
+        .unwrap_or(0);
+    let modes: std::collections::BTreeSet<String> = read_telemetry(&out2.join("telemetry.csv"))
+        .into_iter()
+        .map(|(.., mode)| mode)
+        .collect();
+    println!(
+        "recorded session (epoch {:?}): {recorded:.3} m forward; replayed {} frames into epoch          {:?}: {replayed:.3} m, {refused} refused as unauthentic, modes {modes:?}",
+        epochs[0],
+        teleop.len(),
+        epochs[1]
+    );
     assert!(recorded > 0.5, "the recorded session drove {recorded:.3} m");
     assert!(
-        (replayed - recorded).abs() <= 0.3 * recorded,
-        "replayed {replayed:.3} m vs recorded {recorded:.3} m"
+        epochs[1] > epochs[0],
+        "the restarted controller opened epoch {:?} after {:?}",
+        epochs[1],
+        epochs[0]
+    );
+    assert!(
+        !modes.contains("WheelForward") && !modes.contains("Folding"),
+        "the replay moved the robot: {modes:?}"
+    );
+    assert!(replayed.abs() < 0.05, "replayed run moved {replayed:.3} m");
+    // The controller reports its counters while the simulator runs: most of the replay.
+    assert!(
+        usize::from(refused) * 2 >= teleop.len(),
+        "{refused} of {} replayed frames refused",
+        teleop.len()
     );
 }
 
@@ -273,16 +316,23 @@ impl PacedRobot {
 #[test]
 fn a_teleop_command_from_cansend_folds_the_robot_onto_its_wheels() {
     let _alone = one_at_a_time();
-    // Once the controller reports (it stands in Stop), send `fold` from a shell.
+    // Once the controller reports (it stands in Stop), send STOP and then `fold` from a shell:
+    // commands are authenticated, so a keyholder's tool seals them with the key in the session
+    // the controller announces (read off the bus), with counters 0 and 1 (nobody else sends
+    // commands on this bus); the controller starts interlocked, so STOP comes first.
     let robot = PacedRobot::start("teleop", "8");
-    let fold = AnyMessage::TeleopCommand(protocol::TeleopCommand {
-        mode: protocol::TeleopMode::Fold,
-        body_height: protocol::BodyHeight::saturating_from_si(0.0),
-        speed_scale: protocol::SpeedScale::saturating_from_si(100.0),
-    })
-    .encode(0)
-    .unwrap();
-    cansend(&robot.bus, &fold);
+    let session = announced_session(&read_candump(&robot.log)).expect("an announcement");
+    let command = |mode| {
+        AnyMessage::TeleopCommand(protocol::TeleopCommand {
+            mode,
+            body_height: protocol::BodyHeight::saturating_from_si(0.0),
+            speed_scale: protocol::SpeedScale::saturating_from_si(100.0),
+        })
+    };
+    let mut tool = protocol::Sender::new();
+    for mode in [protocol::TeleopMode::Stop, protocol::TeleopMode::Fold] {
+        cansend(&robot.bus, &tool.seal(&session, &command(mode)).unwrap());
+    }
     let (_bus, _log, out) = robot.finish();
     let rows = read_telemetry(&out.join("telemetry.csv"));
     assert!(
