@@ -217,7 +217,7 @@ impl E2eChecker {
     ) -> E2eStatus {
         let Some(last) = self.last else {
             let found = (0..tries)
-                .map(|high| high << 16 | u32::from(low))
+                .map(|high| high << 16_u32 | u32::from(low))
                 .find(|full| verify(*full));
             return match found {
                 Some(full) => {

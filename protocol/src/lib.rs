@@ -26,9 +26,9 @@
 //! | `0x600`         | [`RejectCounters`]   | controller   | diagnostics | 10 Hz                 |
 //!
 //! Each frame is `[check u32][counter, low 16 bits][payload][zero padding]` ([`e2e`]), bound to
-//! the controller's session ([`session`]); each message's doc
-//! comment gives its payload layout with units and scales. [`busload`] computes the worst-case
-//! load of this schedule; `cargo xtask busload` prints it.
+//! the controller's session ([`session`]); each message's doc comment gives its payload layout
+//! with units and scales. [`busload`] computes the worst-case load of this schedule;
+//! `cargo xtask busload` prints it.
 //!
 //! # Use
 //!

@@ -91,7 +91,7 @@ impl Key {
                         at: at * 2 + offset,
                     })
             };
-            *byte = digit(0)? << 4 | digit(1)?;
+            *byte = digit(0)? << 4_u32 | digit(1)?;
         }
         Ok(Key(key))
     }

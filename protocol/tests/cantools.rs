@@ -24,8 +24,13 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
         AnyMessage::EStop(m) => {
             put("action".into(), f64::from(m.action.raw()), 1.0);
             put("source".into(), f64::from(m.source as u8), 1.0);
+            put("token".into(), f64::from(m.token.raw()), 1.0);
         }
         AnyMessage::Sync(m) => put("tick".into(), f64::from(m.tick.raw()), 1.0),
+        AnyMessage::Announce(m) => {
+            put("version".into(), f64::from(m.version.raw()), 1.0);
+            put("epoch".into(), f64::from(m.epoch.raw()), 1.0);
+        }
         AnyMessage::LegTargets(m) => {
             put("enable".into(), f64::from(m.enable.raw()), 1.0);
             for (name, a) in JOINT_NAMES.iter().zip(m.position) {
@@ -118,6 +123,7 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
                 "sync_lost",
                 "non_finite",
                 "link_degraded",
+                "awaiting_stop",
             ];
             for (bit, flag) in flags.iter().enumerate() {
                 put(
@@ -134,6 +140,11 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
             );
             put("pitch".into(), f64::from(m.pitch.si()), Angle::STEP);
             put("roll".into(), f64::from(m.roll.si()), Angle::STEP);
+            put(
+                "release_token".into(),
+                f64::from(m.release_token.raw()),
+                1.0,
+            );
         }
         AnyMessage::DriveStatus(_, m) => {
             for (bit, flag) in ["enabled", "timed_out", "fault", "estop"]
@@ -194,9 +205,12 @@ fn cantools_decodes_every_frame_the_rust_encoder_produces() {
     }
     messages.sort_by_key(|m| m.id().raw());
 
+    let session = Session::owned(TEST_KEY, Epoch::new(3));
     let mut log = String::new();
+    let mut checks = Vec::new();
     for (i, message) in messages.iter().enumerate() {
-        let frame = message.encode(i as u16).unwrap();
+        let frame = message.encode(&session, i as u32).unwrap();
+        checks.push(u32::from_le_bytes(frame.data()[..4].try_into().unwrap()));
         let hex: String = frame.data().iter().map(|b| format!("{b:02X}")).collect();
         log.push_str(&format!(
             "({}.{:06}) vcan0 {:03X}##1{hex}\n",
@@ -234,6 +248,7 @@ fn cantools_decodes_every_frame_the_rust_encoder_produces() {
             .map(|(k, v)| (k.clone(), v.as_f64().unwrap()))
             .collect();
         assert_eq!(signals["E2E_Counter"], i as f64);
+        assert_eq!(signals["E2E_Check"], f64::from(checks[i]));
         let expected = expected_signals(message);
         assert_eq!(
             signals.len(),

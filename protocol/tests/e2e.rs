@@ -468,13 +468,19 @@ proptest! {
     #[test]
     fn a_replayed_earlier_frame_is_refused_according_to_its_age(
         (start, gaps) in history(),
-        age in prop_oneof![0_u32..0x100, 0x7F00_u32..0x8100, 0_u32..(6 << 16)],
+        age in prop_oneof![
+            0_u32..0x100,
+            0x7F00_u32..0x8100,
+            0_u32..(6 << 16),
+            proptest::sample::select(&[0x7FFF_u32, 0x8000, 0x8001, 0xFFFF, 0x1_0000, 0x1_0001][..]),
+        ],
     ) {
         let start = start + (6 << 16);
         let (mut checker, last) = replay_history(start, &gaps);
+        // 2^15 behind is still behind; ahead by 2^15 is not ahead (see below).
         let expected = match age {
             0 => E2eStatus::Repeated,
-            1..=0x7FFF => E2eStatus::WrongSequence,
+            1..=0x8000 => E2eStatus::WrongSequence,
             _ => E2eStatus::CheckFailed,
         };
         prop_assert_eq!(offer(&mut checker, last - age), expected);
