@@ -38,7 +38,7 @@ pub struct Status {
     pub ik_failures: u32,
 }
 
-/// Why [`Controller::new`] refused a configuration.
+/// Why [`Controller::new`](crate::control::controller::Controller::new) refused a configuration.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[non_exhaustive]
 pub enum ConfigError {
