@@ -205,6 +205,23 @@ fn last_ramp_ticks(config: &StopConfig, rate: TickRate, elapsed: u32) -> u32 {
         .saturating_sub(1)
 }
 
+/// The ramp from `from` into the kickstand pose, started at `now`, `elapsed` ticks after the
+/// latch, ending (with the settle time after it) at the cut.
+fn kickstand_ramp(
+    config: &StopConfig,
+    rate: TickRate,
+    from: Joints<f32>,
+    now: Tick,
+    elapsed: u32,
+) -> Ramp {
+    Ramp {
+        from,
+        to: config.kickstand(),
+        start: now,
+        ticks: last_ramp_ticks(config, rate, elapsed),
+    }
+}
+
 /// Where the stop is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Phase {
@@ -248,7 +265,8 @@ pub struct Stop {
     config: StopConfig,
     rate: TickRate,
     latched: Tick,
-    fold: Joints<f32>,
+    /// Ticks the kickstand needs from the fold, settle time and one spare tick included.
+    kickstand_needed: u32,
     phase: Phase,
 }
 
@@ -273,18 +291,23 @@ impl Stop {
                 rate,
             )),
             // Slowly as the deadline allows: the descent of the torso scales with it.
-            Carrier::Legs => Phase::Kickstand(Ramp {
-                from: legs_rad,
-                to: config.kickstand(),
-                start: now,
-                ticks: last_ramp_ticks(&config, rate, 0),
-            }),
+            Carrier::Legs => Phase::Kickstand(kickstand_ramp(&config, rate, legs_rad, now, 0)),
         };
+        // The fastest kickstand from the fold, settled, with one tick to spare: what the
+        // braking must leave before the cut.
+        let kickstand_needed = ramp_ticks(
+            &fold_rad,
+            &config.kickstand(),
+            config.kickstand_rate_rad_s,
+            rate,
+        )
+        .saturating_add(rate.ticks_from_ms(config.settle_ms))
+        .saturating_add(1);
         Self {
             config,
             rate,
             latched: now,
-            fold: fold_rad,
+            kickstand_needed,
             phase,
         }
     }
@@ -308,12 +331,7 @@ impl Stop {
                 let at_rest = input.braked && ground.abs() < rest && turn.abs() < rest;
                 let next = ((done && at_rest) || self.kickstand_due(now)).then(|| {
                     let elapsed = now.since(self.latched);
-                    Phase::Kickstand(Ramp {
-                        from: pose,
-                        to: self.config.kickstand(),
-                        start: now,
-                        ticks: last_ramp_ticks(&self.config, self.rate, elapsed),
-                    })
+                    Phase::Kickstand(kickstand_ramp(&self.config, self.rate, pose, now, elapsed))
                 });
                 (StopCommand::Servo(pose), next)
             }
@@ -337,15 +355,8 @@ impl Stop {
     /// Whether the kickstand must start now to be reached and settled before the deadline
     /// (planned from the fold, with one tick to spare).
     fn kickstand_due(&self, now: Tick) -> bool {
-        let fastest = ramp_ticks(
-            &self.fold,
-            &self.config.kickstand(),
-            self.config.kickstand_rate_rad_s,
-            self.rate,
-        );
-        let needed = fastest
-            .saturating_add(self.rate.ticks_from_ms(self.config.settle_ms))
-            .saturating_add(1);
-        now.since(self.latched).saturating_add(needed) >= cut_ticks(self.rate)
+        now.since(self.latched)
+            .saturating_add(self.kickstand_needed)
+            >= cut_ticks(self.rate)
     }
 }
