@@ -1,5 +1,6 @@
 //! Every tunable of the controller in one value, with the report's numbers as defaults.
 
+use crate::control::stop::StopConfig;
 use crate::legs::gait::TrotParams;
 use crate::legs::kinematics::LegGeometry;
 use crate::legs::posture::Posture;
@@ -68,6 +69,8 @@ pub struct Config {
     pub link_recover_permille: u32,
     /// Pitch or roll beyond this is a fall: fault, rad.
     pub tilt_limit_rad: f32,
+    /// The E-stop's controlled stop (within [`crate::control::safety::SS1_DEADLINE_MS`]).
+    pub stop: StopConfig,
 }
 
 /// Per-wheel torque limit of the robot, N·m.
@@ -106,6 +109,7 @@ impl Config {
         link_degrade_permille: 100,
         link_recover_permille: 30,
         tilt_limit_rad: crate::math::deg_to_rad(45.0),
+        stop: StopConfig::ROBOT,
     };
 
     /// This configuration at another control rate (gains are per second, so only the tick

@@ -16,6 +16,7 @@ use protocol::{
 };
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
+use sim_host::robot::drive_core::{Authority, SS1_TIMER_US};
 use sim_host::robot::imu::ImuNoise;
 use sim_host::robot::model::DEFAULT_MODEL;
 use sim_host::session::simulator::{Simulator, StartPose};
@@ -326,7 +327,7 @@ fn corrupted_and_replayed_commands_are_rejected_counted_and_never_applied() {
 }
 
 #[test]
-fn an_e_stop_frame_stops_every_drive_until_it_is_cleared() {
+fn an_e_stop_frame_lets_the_drives_obey_for_the_ss1_timer_then_stops_them_until_the_clear() {
     let (mut sim, mut bus, ctl) = setup();
     ctl.borrow_mut().wheel_torque_nm = [3.0, 3.0];
     run(&mut sim, &mut bus, &ctl, 25, |_| {});
@@ -334,23 +335,36 @@ fn an_e_stop_frame_stops_every_drive_until_it_is_cleared() {
     let estop = |estop| ctl.borrow_mut().seal(AnyMessage::EStop(estop));
     let latch = estop(EStop::latch(NodeId::Tool));
     ctl.borrow_mut().extra = vec![latch];
-    let mut stopped_within_cycles = None;
+    let timer_cycles = (SS1_TIMER_US / (1_000_000 / u64::from(HZ))) as usize;
+    let mut off_from = None;
     let mut n = 0;
-    run(&mut sim, &mut bus, &ctl, 50, |s| {
+    // The controller keeps commanding torque all along; a second latch half-way does not
+    // restart the timer.
+    run(&mut sim, &mut bus, &ctl, timer_cycles as u64 + 50, |s| {
         n += 1;
-        let off = s.hardware().wheel_torque_nm(s.now_us()) == [0.0; 2]
-            && (0..4).all(|leg| !s.physics().leg_enabled(leg));
-        if off && stopped_within_cycles.is_none() {
-            stopped_within_cycles = Some(n);
+        let now = s.now_us();
+        let hardware = s.hardware();
+        let authorities: Vec<_> = (hardware.legs().iter().map(|leg| leg.core()))
+            .chain([hardware.wheel().core()])
+            .map(|core| core.authority(now))
+            .collect();
+        let off = authorities.iter().all(|a| *a == Authority::TorqueOff)
+            && hardware.wheel_torque_nm(now) == [0.0; 2];
+        let on = authorities.iter().all(|a| *a == Authority::Drive)
+            && hardware.wheel_torque_nm(now) == [3.0; 2];
+        if n == timer_cycles / 2 {
+            ctl.borrow_mut().extra = vec![estop(EStop::latch(NodeId::Tool))];
         }
-        if stopped_within_cycles.is_some() {
-            assert!(off, "a drive restarted while the E-stop is latched");
+        match off_from {
+            None if off => off_from = Some(n),
+            None => assert!(on, "cycle {n} of the timer: the drives must obey"),
+            Some(_) => assert!(off, "a drive restarted while the E-stop is latched"),
         }
     });
     assert_eq!(
-        stopped_within_cycles,
-        Some(1),
-        "the drives stop in the cycle of the E-stop"
+        off_from,
+        Some(timer_cycles),
+        "the drives obey for the SS1 timer ({timer_cycles} cycles), then stop"
     );
     for status in ctl.borrow().drive_status {
         assert!(status.unwrap().flags.contains(DriveFlags::ESTOP));
@@ -360,6 +374,9 @@ fn an_e_stop_frame_stops_every_drive_until_it_is_cleared() {
     run(&mut sim, &mut bus, &ctl, 30, |_| {});
     assert_eq!(sim.hardware().wheel_torque_nm(sim.now_us()), [3.0, 3.0]);
     assert!((0..4).all(|leg| sim.physics().leg_enabled(leg)));
+    for status in ctl.borrow().drive_status {
+        assert!(!status.unwrap().flags.contains(DriveFlags::ESTOP));
+    }
 }
 
 #[test]

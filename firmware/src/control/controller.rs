@@ -4,19 +4,19 @@
 //! Each tick ([`Controller::step`]):
 //! 1. the supervisor checks the watchdogs and the tilt and raises faults;
 //! 2. a running transition that has arrived fires `PoseReached`;
-//! 3. the state picks the legs' goal pose (hold, stance, trot, fold) and the wheels' law
-//!    (balance + turn loop, or nothing);
+//! 3. the state picks the legs' goal pose (hold, stance, trot, fold, or the E-stop's controlled
+//!    [`stop`](crate::control::stop)) and the wheels' law (balance + turn loop, or nothing);
 //! 4. the legs' targets move toward the goal with the report's smoothing;
 //! 5. every output is clamped to the joint and torque limits and made finite.
 
-use protocol::{
-    AnyMessage, ControllerMode, DriveFlags, EStopAction, FaultFlags, Joints, Leg, PerDrive,
-};
+use protocol::{AnyMessage, DriveFlags, EStopAction, FaultFlags, Joints, Leg, PerDrive};
 
 use crate::config::Config;
 use crate::control::fsm::{Direction, Event, LegMotion, State, WheelMotion};
+pub use crate::control::output::{ConfigError, Output, Status};
 use crate::control::safety::{clamp_leg_targets, clamp_wheel_torques};
 use crate::control::sensors::Sensors;
+use crate::control::stop::{Carrier, Stop, StopCommand, StopInput};
 use crate::control::teleop::Teleop;
 use crate::legs::gait::Trot;
 use crate::legs::kinematics::LegJoints;
@@ -24,49 +24,6 @@ use crate::legs::smoothing::Smoother;
 use crate::time::Tick;
 use crate::wheels::balance::{Balance, BalanceInput};
 use crate::wheels::wheel::{mix, SpeedLoop};
-
-/// What the controller commands this tick.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Output {
-    /// Whether the leg drives should servo (false: torque-free).
-    pub legs_enabled: bool,
-    /// Leg joint targets, rad; within the joint ranges and finite.
-    pub leg_targets_rad: Joints<f32>,
-    /// Wheel torques (left, right), N·m; within the torque limit and finite.
-    pub wheel_torque_nm: [f32; 2],
-    /// Telemetry.
-    pub status: Status,
-}
-
-/// The controller's telemetry.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Status {
-    /// Reported mode.
-    pub mode: ControllerMode,
-    /// Active fault causes.
-    pub faults: FaultFlags,
-    /// The tick of this output.
-    pub tick: Tick,
-    /// Body-height offset the legs realise, m.
-    pub body_height_m: f32,
-    /// Torso pitch, rad.
-    pub pitch_rad: f32,
-    /// Torso roll, rad.
-    pub roll_rad: f32,
-    /// IK solutions that failed and were replaced by the previous target (since power-on).
-    pub ik_failures: u32,
-}
-
-/// Why [`Controller::new`] refused a configuration.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[non_exhaustive]
-pub enum ConfigError {
-    /// The trot frequency is zero or not below the control rate.
-    TrotFrequency,
-    /// The link monitor's window is shorter than one tick, or its thresholds are not
-    /// `recover ≤ degrade ≤ 1000 ‰` (checked by [`crate::node::Node::new`], which runs it).
-    LinkMonitor,
-}
 
 /// The robot's controller.
 #[derive(Debug, Clone)]
@@ -94,6 +51,8 @@ pub struct Controller {
     /// [`Controller::set_link_degraded`]).
     link_degraded: bool,
     ik_failures: u32,
+    /// The controlled stop of the present E-stop (`None` outside `EStop`).
+    stop: Option<Stop>,
 }
 
 impl Controller {
@@ -121,6 +80,7 @@ impl Controller {
             non_finite: false,
             link_degraded: false,
             ik_failures: 0,
+            stop: None,
         })
     }
 
@@ -175,7 +135,7 @@ impl Controller {
     pub fn on_message(&mut self, now: Tick, message: &AnyMessage) {
         match message {
             AnyMessage::EStop(estop) => match estop.action {
-                EStopAction::Latch => self.apply(Event::EStopLatch),
+                EStopAction::Latch => self.latch(now),
                 EStopAction::Clear => self.apply(Event::EStopClear),
             },
             AnyMessage::LegFeedback(leg, feedback) => self.sensors.record_leg(now, *leg, feedback),
@@ -223,10 +183,13 @@ impl Controller {
         let mut wheel_torque_nm = [0.0; 2];
         let mut legs_enabled = self.armed;
         match self.state {
-            State::EStop => {
-                legs_enabled = false;
-                self.follow_measured();
-            }
+            State::EStop => match self.stop_command(now) {
+                StopCommand::Servo(targets) => self.legs_rad = targets,
+                StopCommand::Off => {
+                    legs_enabled = false;
+                    self.follow_measured();
+                }
+            },
             State::Hold | State::Fault => {}
             State::Standing(motion) if self.rolling() => {
                 // Stop on the wheels first: legs that unfold under a rolling robot lift it off
@@ -248,7 +211,7 @@ impl Controller {
                 self.smooth(self.config.fold_rate_per_s);
             }
         }
-        if self.state.balancing() && self.armed && self.wheels_may_drive() {
+        if self.balancing() && self.armed && self.wheels_may_drive() {
             wheel_torque_nm = self.wheel_law(now, dt_s);
         } else {
             self.balance.reset();
@@ -343,6 +306,53 @@ impl Controller {
         }
     }
 
+    /// An E-stop latch at `now`: `EStop` from this tick on, with a controlled stop if the robot
+    /// is under way, or every drive torque-free at once from `Hold`, `Fault` or unarmed (see
+    /// [`crate::control::stop`]). A latch while latched changes nothing.
+    fn latch(&mut self, now: Tick) {
+        if self.state == State::EStop {
+            return;
+        }
+        let carrier = if !self.armed || matches!(self.state, State::Hold | State::Fault) {
+            Carrier::Nothing
+        } else if self.wheels_may_drive() {
+            Carrier::Wheels
+        } else {
+            Carrier::Legs
+        };
+        let (config, rate) = (self.config.stop, self.config.rate);
+        let stop = Stop::new(config, rate, now, self.legs_rad, self.fold_rad, carrier);
+        self.stop = Some(stop);
+        self.apply(Event::EStopLatch);
+    }
+
+    /// This tick of the controlled stop (torque-free if none runs).
+    fn stop_command(&mut self, now: Tick) -> StopCommand {
+        let r = self.config.balance.wheel_radius_m;
+        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        let input = StopInput {
+            now,
+            speeds_m_s: [
+                r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s),
+                r * self.sensors.differential_wheel_rate_rad_s(),
+            ],
+            braked: self.balance.velocity_ref_m_s() == 0.0,
+            fault: self.non_finite || !self.fault_causes(now).is_empty(),
+        };
+        self.stop
+            .as_mut()
+            .map_or(StopCommand::Off, |stop| stop.step(&input))
+    }
+
+    /// Whether the balance law runs (where the wheels are on the ground): in the states that
+    /// carry the robot on its wheels, and in `EStop` until the controlled stop cuts the torque.
+    fn balancing(&self) -> bool {
+        match self.state {
+            State::EStop => self.stop.is_some_and(|stop| !stop.off()),
+            state => state.balancing(),
+        }
+    }
+
     /// Whether the robot still rolls on its wheels (ground speed above 5 cm/s, or turning) while
     /// they carry it.
     fn rolling(&self) -> bool {
@@ -391,6 +401,9 @@ impl Controller {
         if self.state == State::EStop {
             // A release moves nothing by itself: the operator sends STOP, then a motion.
             self.teleop.interlock();
+        }
+        if next != State::EStop {
+            self.stop = None;
         }
         self.state = next;
     }

@@ -1,9 +1,12 @@
 //! The control step and what keeps it safe: the [`controller`] runs the [`fsm`]'s mode, with
-//! the [`safety`] watchdogs and clamps around it, the [`sensors`] it last heard and the
-//! operator's [`teleop`] requests.
+//! the [`safety`] watchdogs and clamps around it, the [`sensors`] it last heard, the operator's
+//! [`teleop`] requests and the E-stop's controlled [`stop`]; its [`output`] is the commands and
+//! the telemetry.
 
 pub mod controller;
 pub mod fsm;
+pub mod output;
 pub mod safety;
 pub mod sensors;
+pub mod stop;
 pub mod teleop;

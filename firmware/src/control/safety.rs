@@ -1,9 +1,16 @@
-//! The safety supervisor's parts: watchdogs in ticks, and the last clamp every output passes.
+//! The safety supervisor's parts: watchdogs in ticks, the last clamp every output passes, and
+//! the deadline of the E-stop's controlled stop.
 
 use protocol::{Joints, Leg};
 
 use crate::limits::{Joint, JointLimits};
 use crate::time::Tick;
+
+/// An E-stop latch leaves the controller this long for its controlled stop (IEC 60204-1 stop
+/// category 1, see [`crate::control::stop`]), ms: the drives start a timer of the same length on
+/// the latch frame and cut their torque when it ends whatever they hear, so the controller
+/// disables every drive itself at this deadline at the latest.
+pub const SS1_DEADLINE_MS: u32 = 2_000;
 
 /// Trips when nothing has fed it for `timeout_ticks`. A watchdog never fed counts as expired.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

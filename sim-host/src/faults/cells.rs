@@ -10,6 +10,7 @@ use firmware::control::fsm::State;
 use crate::faults::judge::{fell, forward_m, max_target_step, max_tilt_deg, records_from};
 use crate::faults::matrix::{both, clean_until, run_motion, sent, CellResult, Motion, RUN_S};
 use crate::faults::rig::PERIOD_US;
+use crate::robot::drive_core::SS1_TIMER_US;
 use crate::session::run_stats::RunError;
 use crate::session::SessionError;
 
@@ -287,9 +288,12 @@ pub(super) fn simulator_restarted(model: &Path) -> Result<CellResult, SessionErr
     })
 }
 
+/// An E-stop mid-trot, then a clear: the firmware reports `EStop` from the latch on and makes a
+/// controlled stop (IEC 60204-1 category 1); the drives obey it for their SS1 timer and are
+/// torque-free from its end at the latest, until the clear.
 pub(super) fn estop(model: &Path, from: NodeId) -> Result<CellResult, SessionError> {
     let latch_s = 2.0;
-    let clear_s = 4.0;
+    let clear_s = 5.0;
     let mut rig = clean_until(model, Motion::Trot, latch_s)?;
     // A teleop counts its E-stops; `cansend` sends a fixed frame (counter 0), every time.
     let counter = if from == NodeId::Teleop { 1 } else { 0 };
@@ -306,14 +310,24 @@ pub(super) fn estop(model: &Path, from: NodeId) -> Result<CellResult, SessionErr
     rig.run_until(clear_s + 1.5)?;
     // Records strictly after the latch was sent (the one at `latch_s` closed the cycle before).
     let latched = records_from(rig.records(), latch_s + 1e-6);
-    let first_off = latched
-        .iter()
-        .position(|r| r.torque_off.iter().all(|&o| o) && r.estop.iter().all(|&e| e));
-    let held = latched
+    let until_clear: Vec<_> = latched
         .iter()
         .take_while(|r| r.time_us <= (clear_s * 1e6) as u64)
+        .collect();
+    let reported = until_clear
+        .iter()
+        .all(|r| r.state == Some(State::EStop) && r.faults.contains(FaultFlags::ESTOP_LATCHED));
+    let first_off = until_clear
+        .iter()
+        .position(|r| r.torque_off.iter().all(|&o| o) && r.estop.iter().all(|&e| e));
+    // Rig time at the end of the cycle in which every drive was off, from the latch.
+    let off_after_ms = first_off
+        .and_then(|i| until_clear.get(i))
+        .map(|r| r.time_us as f64 * 1e-3 - latch_s * 1e3);
+    let held = until_clear
+        .iter()
         .skip(first_off.unwrap_or(usize::MAX))
-        .all(|r| r.torque_off.iter().all(|&o| o) && r.state == Some(State::EStop));
+        .all(|r| r.torque_off.iter().all(|&o| o));
     let resumed = records_from(rig.records(), clear_s + 1e-6)
         .iter()
         .find(|r| r.torque_off.iter().all(|&o| !o))
@@ -323,15 +337,21 @@ pub(super) fn estop(model: &Path, from: NodeId) -> Result<CellResult, SessionErr
     } else {
         "cansend (counter 0)"
     };
+    let deadline_ms = SS1_TIMER_US as f64 * 1e-3;
     Ok(CellResult {
         name: format!("trot (L), E-stop from {source}"),
         fault: format!("EStop latch at {latch_s} s, clear at {clear_s} s; L keeps coming"),
-        expected: "all drives stop within one control period, stay stopped until the clear",
+        expected: "EStop reported from the latch tick; a controlled stop, all drives torque-free by the SS1 deadline (2 s) and until the clear; no fall",
         measured: format!(
-            "all 5 drives torque-free in cycle {} after the latch, held until the clear: {held}, driving again {}",
-            first_off.map_or("never".into(), |i| (i + 1).to_string()),
+            "EStop reported throughout: {reported}; all 5 drives torque-free {} after the latch, held until the clear: {held}; max tilt {:.1}°; driving again {}",
+            off_after_ms.map_or("never".into(), |ms| format!("{ms:.0} ms")),
+            max_tilt_deg(latched),
             resumed.map_or("never".into(), |ms| format!("{ms:.0} ms after the clear"))
         ),
-        pass: first_off == Some(0) && held && resumed.is_some(),
+        pass: reported
+            && off_after_ms.is_some_and(|ms| ms <= deadline_ms + 1e-6)
+            && held
+            && !fell(latched)
+            && resumed.is_some(),
     })
 }

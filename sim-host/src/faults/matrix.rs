@@ -171,9 +171,16 @@ pub fn run(model: &Path) -> Result<Vec<CellResult>, SessionError> {
     cells.push(feedback_silent(model)?);
     cells.push(firmware_killed(model)?);
     cells.push(simulator_restarted(model)?);
-    cells.push(estop(model, NodeId::Teleop)?);
-    cells.push(estop(model, NodeId::Tool)?);
+    cells.extend(estop_cells(model)?);
     Ok(cells)
+}
+
+/// The matrix's E-stop cells alone (from the teleop, and from `cansend`).
+pub fn estop_cells(model: &Path) -> Result<Vec<CellResult>, SessionError> {
+    Ok(vec![
+        estop(model, NodeId::Teleop)?,
+        estop(model, NodeId::Tool)?,
+    ])
 }
 
 /// The matrix as a Markdown table.

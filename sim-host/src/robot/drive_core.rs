@@ -1,6 +1,13 @@
 //! What every emulated drive shares, as real drives (moteus, DDT) behave: an acceptance filter,
 //! E2E checks on what passes it, a command timeout, a latching E-stop, and counters for the
 //! status frame.
+//!
+//! The E-stop is a stop of category 1 (IEC 60204-1, "SS1-t"): a latch starts the drive's own
+//! timer of [`SS1_TIMER_US`], during which the drive keeps obeying valid commands so that the
+//! controller can bring the robot to rest and set it down; when the timer runs out the drive
+//! goes torque-free whatever it hears, until a clear. A drive that cut at once would tip a
+//! balancing robot over at speed; the timer bounds how long a controller that does not stop it
+//! can keep it moving.
 
 use protocol::{
     AnyMessage, Count, DriveFlags, DriveStatus, EStopAction, EncodeError, Frame, Key, MessageId,
@@ -11,12 +18,18 @@ use crate::robot::link::NodeLink;
 /// Drive command timeout, as moteus' default: no valid command for this long → torque off.
 pub const COMMAND_TIMEOUT_US: u64 = 100_000;
 
+/// How long a drive keeps obeying commands after an E-stop latch before it goes torque-free on
+/// its own, µs: the controller's controlled stop (`firmware::control::safety::SS1_DEADLINE_MS`)
+/// must end within it.
+pub const SS1_TIMER_US: u64 = 2_000_000;
+
 /// What a drive should do this instant.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Authority {
     /// Apply the last command.
     Drive,
-    /// Torque off: no command yet, the command said so, it timed out, or an E-stop is latched.
+    /// Torque off: no command yet, the command said so, it timed out, or an E-stop latched
+    /// [`SS1_TIMER_US`] or more ago.
     TorqueOff,
 }
 
@@ -27,7 +40,8 @@ pub struct DriveCore {
     link: NodeLink,
     last_command_us: Option<u64>,
     commanded_enable: bool,
-    estop: bool,
+    /// When the E-stop latched, µs (`None`: not latched). A repeated latch keeps the first time.
+    estop_since_us: Option<u64>,
     rejected: u32,
     commands: u32,
 }
@@ -41,7 +55,7 @@ impl DriveCore {
             link: NodeLink::new(key),
             last_command_us: None,
             commanded_enable: false,
-            estop: false,
+            estop_since_us: None,
             rejected: 0,
             commands: 0,
         }
@@ -59,7 +73,10 @@ impl DriveCore {
         match self.link.receive(id, frame.data()) {
             Ok(accepted) => match accepted.message {
                 AnyMessage::EStop(estop) => {
-                    self.estop = estop.action == EStopAction::Latch;
+                    self.estop_since_us = match estop.action {
+                        EStopAction::Latch => self.estop_since_us.or(Some(now_us)),
+                        EStopAction::Clear => None,
+                    };
                     None
                 }
                 AnyMessage::Announce(_) => None,
@@ -91,7 +108,7 @@ impl DriveCore {
     pub fn authority(&self, now_us: u64) -> Authority {
         if self.last_command_us.is_some()
             && self.commanded_enable
-            && !self.estop
+            && !self.ss1_expired(now_us)
             && !self.timed_out(now_us)
         {
             Authority::Drive
@@ -112,7 +129,14 @@ impl DriveCore {
 
     /// Whether an E-stop is latched.
     pub fn estop(&self) -> bool {
-        self.estop
+        self.estop_since_us.is_some()
+    }
+
+    /// Whether an E-stop latched [`SS1_TIMER_US`] or more ago: torque off whatever the commands
+    /// say.
+    pub fn ss1_expired(&self, now_us: u64) -> bool {
+        self.estop_since_us
+            .is_some_and(|t| now_us.saturating_sub(t) >= SS1_TIMER_US)
     }
 
     /// Seals one of this drive's frames in its session (`None` before it has joined one).
@@ -129,7 +153,7 @@ impl DriveCore {
         if self.timed_out(now_us) {
             flags = flags.with(DriveFlags::TIMED_OUT);
         }
-        if self.estop {
+        if self.estop() {
             flags = flags.with(DriveFlags::ESTOP);
         }
         let wrap = |n: u32| Count::from_raw((n & 0xFFFF) as u16).unwrap_or(Count::ZERO);

@@ -1,0 +1,362 @@
+//! The E-stop as a stop of category 1 (IEC 60204-1 "SS1"): the drives stay powered while the
+//! controller brings the robot to rest and sets it down, then every drive goes torque-free.
+//!
+//! # Why not cut at once
+//!
+//! Cutting every drive on the latch (category 0) drops a balancing robot: at 0.48 m/s the
+//! torso pitched 25° onto the folded legs and fell to 0.255 m, and a robot standing on limp legs
+//! sags onto its wheels at 0.45–0.6 m/s and rolls back 25° onto its leg links (both measured in
+//! the simulator). Category 0 stays for faults of the controller itself (`State::Fault`).
+//!
+//! # The sequence
+//!
+//! On the **wheels** (the measured leg pose puts them on the ground when the latch arrives):
+//!
+//! 1. **Brake** — the balance law keeps running with a zero speed reference, which the law
+//!    ramps down at its brake limit
+//!    ([`crate::wheels::balance::BalanceConfig::brake_limit_m_s2`], 0.8 m/s², the same as a
+//!    Stop: from the top speed of 0.48 m/s the reference is at zero after 0.6 s, and the lean
+//!    it costs stays near 6°); the legs ramp into the fold if the latch came mid-fold
+//!    ([`StopConfig::fold_rate_rad_s`]).
+//! 2. **Kickstand** — at rest (ground and turn speed below [`StopConfig::rest_speed_m_s`]),
+//!    or when the deadline leaves no more time, the legs ramp in joint space (smoothstep: the
+//!    joints start and end at rest) into the kickstand pose ([`StopConfig::kickstand_front`],
+//!    [`StopConfig::kickstand_back`]), as slowly as the deadline allows. The balance law runs
+//!    while the leg pose leaves the wheels on the ground, and stops once the feet carry the robot
+//!    ([`crate::legs::support`]). The front legs end stretched forward on their joint stops, the
+//!    back legs behind and deeper than the wheels, so the robot comes to rest leaning about 12°
+//!    forward on its front feet and wheels. Unpowered, a front leg pushed up by the ground presses
+//!    its hip, knee and ankle further into their stops: the legs are struts, and cutting the
+//!    torque changes nothing.
+//! 3. **Settle** — the kickstand pose is held for [`StopConfig::settle_ms`].
+//! 4. **Off** — legs disabled, wheel torque 0.
+//!
+//! On the **legs** (standing, trotting, standing up) the legs ramp straight from where they are
+//! into the kickstand pose, over all the time the deadline leaves: this sits the torso down onto
+//! its wheels and front feet; then Settle and Off.
+//!
+//! Why a kickstand: unpowered on its wheels with the legs folded, the robot rolls back 26° onto
+//! its leg links (its centre of mass sits just behind the axle), and limp legs cannot carry it
+//! (a scan of poses dropped unpowered onto the wheels and nudged either way found no folded pose
+//! below 23°, and the kickstand at 12° either way). The front legs cannot reach their stops
+//! without touching the ground: their shank passes vertical on the way, which puts the foot
+//! 0.30 m below the hip, deeper than the 0.235 m the wheels leave. So the sweep lifts the robot
+//! onto its feet for a moment and sets it back down, under power.
+//!
+//! Whatever remains undone one tick before [`SS1_DEADLINE_MS`] after the latch is cut then: the
+//! drives start their own timer of the same length on the latch frame and cut torque when it
+//! ends, so the controller's stop must be over by then. A robot doing nothing (`Hold`), already
+//! in `Fault`, or not yet armed is cut at once; any fault cause during the sequence (a drive
+//! fault, stale feedback or IMU, a fall, a non-finite output) cuts at once too: a fault can only
+//! cut torque sooner.
+
+use protocol::{Joints, Leg};
+
+use crate::control::safety::SS1_DEADLINE_MS;
+use crate::legs::kinematics::LegJoints;
+use crate::math::deg_to_rad;
+use crate::time::{Tick, TickRate};
+
+/// Tunables of the controlled stop.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StopConfig {
+    /// Largest joint rate of the ramp into the fold when the latch came mid-fold, rad/s
+    /// (reached mid-ramp; the mean is two thirds of it).
+    pub fold_rate_rad_s: f32,
+    /// Largest joint rate of the fastest ramp into the kickstand pose, rad/s: it decides when the
+    /// kickstand must start at the latest to be settled before the deadline.
+    pub kickstand_rate_rad_s: f32,
+    /// Ground and turn speed below which the robot counts as at rest, m/s.
+    pub rest_speed_m_s: f32,
+    /// How long the kickstand pose is held, balancing, before the torque goes, ms.
+    pub settle_ms: u32,
+    /// Kickstand pose of the front legs.
+    pub kickstand_front: LegJoints,
+    /// Kickstand pose of the back legs.
+    pub kickstand_back: LegJoints,
+}
+
+impl StopConfig {
+    /// The robot's stop. The kickstand pose was chosen by a scan of poses dropped unpowered on
+    /// the wheels and nudged either way (each ended at 12.4° forward, on the front feet).
+    pub const ROBOT: Self = Self {
+        fold_rate_rad_s: 2.0,
+        kickstand_rate_rad_s: 3.0,
+        rest_speed_m_s: 0.02,
+        settle_ms: 100,
+        kickstand_front: LegJoints {
+            hip_abduction_rad: 0.0,
+            hip_pitch_rad: deg_to_rad(50.0),
+            knee_rad: deg_to_rad(15.0),
+            ankle_rad: deg_to_rad(40.0),
+        },
+        kickstand_back: LegJoints {
+            hip_abduction_rad: 0.0,
+            hip_pitch_rad: deg_to_rad(-50.0),
+            knee_rad: deg_to_rad(15.0),
+            ankle_rad: deg_to_rad(40.0),
+        },
+    };
+
+    /// The kickstand pose of all four legs.
+    pub fn kickstand(&self) -> Joints<f32> {
+        let (front, back) = (
+            self.kickstand_front.to_array(),
+            self.kickstand_back.to_array(),
+        );
+        Joints::from_leg_fn(|leg| match leg {
+            Leg::Fl | Leg::Fr => front,
+            Leg::Bl | Leg::Br => back,
+        })
+    }
+}
+
+/// A joint-space move from one pose to another over a whole number of ticks, with a smoothstep
+/// profile (zero joint rate at both ends; the peak rate is 1.5 times the mean).
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Ramp {
+    from: Joints<f32>,
+    to: Joints<f32>,
+    start: Tick,
+    ticks: u32,
+}
+
+impl Ramp {
+    /// From `from` to `to` starting at `start`, no joint faster than `peak_rate_rad_s`.
+    fn new(
+        from: Joints<f32>,
+        to: Joints<f32>,
+        start: Tick,
+        peak_rate_rad_s: f32,
+        rate: TickRate,
+    ) -> Self {
+        Self {
+            from,
+            to,
+            start,
+            ticks: ramp_ticks(&from, &to, peak_rate_rad_s, rate),
+        }
+    }
+
+    /// The pose at `now`, and whether the ramp is over.
+    fn at(&self, now: Tick) -> (Joints<f32>, bool) {
+        let elapsed = now.since(self.start);
+        if elapsed >= self.ticks {
+            return (self.to, true);
+        }
+        let s = elapsed as f32 / self.ticks as f32;
+        let blend = s * s * (3.0 - 2.0 * s);
+        let mut pose = self.from;
+        for (joint, goal) in pose.iter_mut().zip(self.to.iter()) {
+            *joint += blend * (goal - *joint);
+        }
+        (pose, false)
+    }
+}
+
+/// Ticks for a smoothstep ramp from `from` to `to` whose fastest joint peaks at
+/// `peak_rate_rad_s` (a non-finite or non-positive rate, or a non-finite pose, gives 0: jump).
+fn ramp_ticks(from: &Joints<f32>, to: &Joints<f32>, peak_rate_rad_s: f32, rate: TickRate) -> u32 {
+    let largest = from
+        .iter()
+        .zip(to.iter())
+        .map(|(a, b)| (b - a).abs())
+        .fold(0.0_f32, f32::max);
+    // Smoothstep peaks at 1.5 × the mean rate.
+    let seconds = 1.5 * largest / peak_rate_rad_s;
+    let ticks = seconds * rate.hz() as f32;
+    if !(ticks.is_finite() && ticks > 0.0) {
+        return 0;
+    }
+    // Rounded up (the cast truncates, and saturates past u32::MAX).
+    let whole = ticks as u32;
+    if (whole as f32) < ticks {
+        whole.saturating_add(1)
+    } else {
+        whole
+    }
+}
+
+/// What carries the robot when the E-stop latches, which decides how it stops.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Carrier {
+    /// Nothing moves under power (`Hold`, `Fault`, not armed): torque off at once.
+    Nothing,
+    /// The wheels, balancing: brake to rest, then the kickstand.
+    Wheels,
+    /// The legs: straight into the kickstand, which lowers the torso onto the wheels.
+    Legs,
+}
+
+/// Ticks from the latch at which the controller cuts the torque whatever the sequence has done:
+/// one tick before [`SS1_DEADLINE_MS`], since the controller may hear the latch frame a tick
+/// after the drives, which time their own cut from it.
+fn cut_ticks(rate: TickRate) -> u32 {
+    rate.ticks_from_ms(SS1_DEADLINE_MS).saturating_sub(1)
+}
+
+/// Length of a kickstand ramp started `elapsed` ticks after the latch that ends, with the settle
+/// time after it, at the cut: as slow as the deadline allows, since the torso's motion scales
+/// with the joints'.
+fn last_ramp_ticks(config: &StopConfig, rate: TickRate, elapsed: u32) -> u32 {
+    cut_ticks(rate)
+        .saturating_sub(elapsed)
+        .saturating_sub(rate.ticks_from_ms(config.settle_ms))
+        .saturating_sub(1)
+}
+
+/// The ramp from `from` into the kickstand pose, started at `now`, `elapsed` ticks after the
+/// latch, ending (with the settle time after it) at the cut.
+fn kickstand_ramp(
+    config: &StopConfig,
+    rate: TickRate,
+    from: Joints<f32>,
+    now: Tick,
+    elapsed: u32,
+) -> Ramp {
+    Ramp {
+        from,
+        to: config.kickstand(),
+        start: now,
+        ticks: last_ramp_ticks(config, rate, elapsed),
+    }
+}
+
+/// Where the stop is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Phase {
+    /// On the wheels: braking to rest, balancing, legs ramping into the fold (they are there
+    /// unless the latch came mid-fold).
+    Brake(Ramp),
+    /// Legs ramping into the kickstand pose, balancing while the wheels are on the ground.
+    Kickstand(Ramp),
+    /// Kickstand reached at this tick; balancing until the settle time has passed.
+    Settle(Tick),
+    /// Every drive torque-free.
+    Off,
+}
+
+/// What the controller measures for the stop each tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StopInput {
+    /// This tick.
+    pub now: Tick,
+    /// Ground speed of the axle and half the speed difference of the wheels, m/s.
+    pub speeds_m_s: [f32; 2],
+    /// Whether the balance law's speed reference has come to zero.
+    pub braked: bool,
+    /// Whether a fault cause is active (a fault cuts torque at once).
+    pub fault: bool,
+}
+
+/// What the stop asks of the drives this tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum StopCommand {
+    /// Servo the legs to these targets, and balance with a zero speed reference while the
+    /// wheels are on the ground.
+    Servo(Joints<f32>),
+    /// Every drive torque-free.
+    Off,
+}
+
+/// A running controlled stop, from the latch until it is cleared.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stop {
+    config: StopConfig,
+    rate: TickRate,
+    latched: Tick,
+    /// Ticks the kickstand needs from the fold, settle time and one spare tick included.
+    kickstand_needed: u32,
+    phase: Phase,
+}
+
+impl Stop {
+    /// A stop latched at `now` with the legs at `legs_rad` and the robot on `carrier`
+    /// (`fold_rad`: the fold pose the wheels brake in).
+    pub fn new(
+        config: StopConfig,
+        rate: TickRate,
+        now: Tick,
+        legs_rad: Joints<f32>,
+        fold_rad: Joints<f32>,
+        carrier: Carrier,
+    ) -> Self {
+        let phase = match carrier {
+            Carrier::Nothing => Phase::Off,
+            Carrier::Wheels => Phase::Brake(Ramp::new(
+                legs_rad,
+                fold_rad,
+                now,
+                config.fold_rate_rad_s,
+                rate,
+            )),
+            // Slowly as the deadline allows: the descent of the torso scales with it.
+            Carrier::Legs => Phase::Kickstand(kickstand_ramp(&config, rate, legs_rad, now, 0)),
+        };
+        // The fastest kickstand from the fold, settled, with one tick to spare: what the
+        // braking must leave before the cut.
+        let kickstand_needed = ramp_ticks(
+            &fold_rad,
+            &config.kickstand(),
+            config.kickstand_rate_rad_s,
+            rate,
+        )
+        .saturating_add(rate.ticks_from_ms(config.settle_ms))
+        .saturating_add(1);
+        Self {
+            config,
+            rate,
+            latched: now,
+            kickstand_needed,
+            phase,
+        }
+    }
+
+    /// Whether every drive is torque-free from now until the clear.
+    pub fn off(&self) -> bool {
+        self.phase == Phase::Off
+    }
+
+    /// One tick of the stop.
+    pub fn step(&mut self, input: &StopInput) -> StopCommand {
+        let now = input.now;
+        if input.fault || now.since(self.latched) >= cut_ticks(self.rate) {
+            self.phase = Phase::Off;
+        }
+        let (command, next) = match self.phase {
+            Phase::Brake(ramp) => {
+                let (pose, done) = ramp.at(now);
+                let [ground, turn] = input.speeds_m_s;
+                let rest = self.config.rest_speed_m_s;
+                let at_rest = input.braked && ground.abs() < rest && turn.abs() < rest;
+                let next = ((done && at_rest) || self.kickstand_due(now)).then(|| {
+                    let elapsed = now.since(self.latched);
+                    Phase::Kickstand(kickstand_ramp(&self.config, self.rate, pose, now, elapsed))
+                });
+                (StopCommand::Servo(pose), next)
+            }
+            Phase::Kickstand(ramp) => {
+                let (pose, done) = ramp.at(now);
+                (StopCommand::Servo(pose), done.then_some(Phase::Settle(now)))
+            }
+            Phase::Settle(since) => {
+                let settled = now.since(since) >= self.rate.ticks_from_ms(self.config.settle_ms);
+                let pose = self.config.kickstand();
+                (StopCommand::Servo(pose), settled.then_some(Phase::Off))
+            }
+            Phase::Off => (StopCommand::Off, None),
+        };
+        if let Some(next) = next {
+            self.phase = next;
+        }
+        command
+    }
+
+    /// Whether the kickstand must start now to be reached and settled before the deadline
+    /// (planned from the fold, with one tick to spare).
+    fn kickstand_due(&self, now: Tick) -> bool {
+        now.since(self.latched)
+            .saturating_add(self.kickstand_needed)
+            >= cut_ticks(self.rate)
+    }
+}
