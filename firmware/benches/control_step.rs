@@ -12,8 +12,8 @@ use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use firmware::{Config, Controller, Node, Tick};
 use protocol::{
     Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, Epoch, Frame, Imu, JointVelocity,
-    Joints, LegFeedback, QuatComponent, Sender, Session, SpeedScale, TeleopCommand,
-    TeleopHeartbeat, TeleopMode, Torque, WheelAngle, WheelFeedback, WheelVelocity, TEST_KEY,
+    Joints, LegFeedback, Sender, Session, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode,
+    Torque, WheelFeedback, WheelVelocity, TEST_KEY,
 };
 
 /// The node's session, in which the plant and the operator seal their frames.
@@ -34,12 +34,11 @@ fn feedback(joints_rad: &Joints<f32>) -> Vec<AnyMessage> {
         })
         .collect();
     messages.push(AnyMessage::WheelFeedback(WheelFeedback {
-        position: [WheelAngle::saturating_from_si(0.5); 2],
         velocity: [WheelVelocity::saturating_from_si(2.0); 2],
         effort: [Torque::saturating_from_si(1.0); 2],
     }));
     messages.push(AnyMessage::Imu(Imu {
-        orientation: [0.9999, 0.0, 0.0123, 0.0].map(QuatComponent::saturating_from_si),
+        orientation: Imu::orientation_of([0.9999, 0.0, 0.0123, 0.0]),
         angular_rate: [0.0, 0.05, 0.0].map(AngularRate::saturating_from_si),
         acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
     }));

@@ -53,6 +53,16 @@ impl TickRate {
         1.0 / self.hz as f32
     }
 
+    /// Milliseconds in `ticks` ticks (rounded down, saturating at `u32::MAX`).
+    pub const fn ms_from_ticks(self, ticks: u32) -> u32 {
+        let ms = ticks as u64 * 1000 / self.hz as u64;
+        if ms > u32::MAX as u64 {
+            u32::MAX
+        } else {
+            ms as u32
+        }
+    }
+
     /// The number of whole ticks that covers at least `ms` milliseconds (rounded up, so a
     /// watchdog never fires early).
     pub const fn ticks_from_ms(self, ms: u32) -> u32 {

@@ -12,8 +12,8 @@ use firmware::{Config, Controller, Tick};
 use proptest::prelude::*;
 use protocol::{
     Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, EStop, EStopAction, FaultFlags, Imu,
-    JointVelocity, Joints, Leg, LegFeedback, NodeId, QuatComponent, ReleaseToken, SpeedScale,
-    TeleopCommand, TeleopHeartbeat, TeleopMode, Torque, WheelAngle, WheelFeedback, WheelVelocity,
+    JointVelocity, Joints, Leg, LegFeedback, NodeId, ReleaseToken, SpeedScale, TeleopCommand,
+    TeleopHeartbeat, TeleopMode, Torque, WheelFeedback, WheelVelocity,
 };
 
 const CONFIG: Config = Config::ROBOT;
@@ -490,13 +490,12 @@ fn any_message() -> impl Strategy<Value = AnyMessage> {
             prop::array::uniform3(-30.0f32..30.0)
         )
             .prop_map(|(q, w)| AnyMessage::Imu(Imu {
-                orientation: q.map(QuatComponent::saturating_from_si),
+                orientation: Imu::orientation_of(q),
                 angular_rate: w.map(AngularRate::saturating_from_si),
                 acceleration: [Acceleration::saturating_from_si(0.0); 3],
             })),
         prop::array::uniform2(-300.0f32..300.0).prop_map(|v| AnyMessage::WheelFeedback(
             WheelFeedback {
-                position: [WheelAngle::saturating_from_si(0.0); 2],
                 velocity: v.map(WheelVelocity::saturating_from_si),
                 effort: [Torque::saturating_from_si(0.0); 2],
             }

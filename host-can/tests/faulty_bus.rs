@@ -7,6 +7,7 @@ use host_can::bus::Bus;
 use host_can::fault_plan::Faults;
 use host_can::faulty_bus::FaultyBus;
 use host_can::inproc_bus::{InprocBus, InprocEndpoint};
+use protocol::SessionTime;
 use protocol::{
     decode_frame, Announce, AnyMessage, BodyHeight, EStop, Epoch, Frame, NodeId, Receiver,
     RejectCause, Sender, Session, SpeedScale, Sync, TeleopCommand, TeleopMode, Tick, WireVersion,
@@ -201,6 +202,7 @@ fn a_flood_keeps_one_valid_sequence() {
     let announce = AnyMessage::Announce(Announce {
         version: WireVersion::THIS,
         epoch: SESSION.epoch().unwrap(),
+        time: SessionTime::from_ms(0),
     });
     other
         .send(&Sender::new().seal(&SESSION, &announce).unwrap())

@@ -140,7 +140,7 @@ pub const SCHEDULE: [Slot; 20] = [
     slot(MessageId::TeleopHeartbeat, Period::Hz(50), 7),
     slot(MessageId::ControllerStatus, Period::Hz(50), 11),
     slot(MessageId::RejectCounters, Period::Hz(10), 15),
-    slot(MessageId::Announce, Period::Hz(10), 39),
+    slot(MessageId::Announce, Period::Hz(50), 19),
     slot(MessageId::DriveStatus(Drive::LegFl), Period::Hz(10), 19),
     slot(MessageId::DriveStatus(Drive::LegFr), Period::Hz(10), 23),
     slot(MessageId::DriveStatus(Drive::LegBl), Period::Hz(10), 27),

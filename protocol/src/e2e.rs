@@ -149,7 +149,8 @@ pub enum E2eStatus {
         /// Frames missing since the previous accepted one.
         lost: u32,
     },
-    /// First frame of this sender in the session. Accept.
+    /// First frame of this sender in the session, or the first after it restarted or after a
+    /// gap the sequence cannot span, found by the receiver's [`Search`]. Accept.
     Initial,
     /// Same counter as the previous frame, and a valid check: a duplicate or a replay. Reject.
     Repeated,
@@ -170,30 +171,59 @@ impl E2eStatus {
     }
 }
 
-/// How many high halves a receiver tries for the first frame of a sender it has not heard in
-/// this session: it may have joined late, after the sender's counter passed 2^16. A CRC is
-/// cheap to try 256 times (2^24 frames: 4.6 h at 1 kHz); a MAC is tried at high half zero only,
-/// so that a flood of forged first frames costs one CMAC each.
-pub const fn join_tries(check: Check) -> u32 {
-    match check {
-        Check::Crc => 256,
-        Check::Mac => 1,
+/// Where a receiver looks for a frame that does not follow the sequence it knows (or the
+/// first frame of a sender it has not heard): the high halves from the one after
+/// `reference`'s down, at most `tries` of them, and only counters after the last accepted one.
+///
+/// A sender starts its counters at the session time it joins at (see [`crate::session`]) and
+/// counts one per frame from there, so a sender that restarted, a receiver that joined late,
+/// and a sequence with a gap of 2^15 frames or more are all found within a few halves of the
+/// session time, while a replay (at or behind the last accepted counter) never is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Search {
+    /// The receiver's session time, ms.
+    pub reference: u32,
+    /// Most high halves to try.
+    pub tries: u32,
+}
+
+impl Search {
+    /// The search a receiver makes for `check`: a CRC is cheap and anyone can forge one anyway,
+    /// so it is tried over 2^12 halves (2^28 frames); a MAC costs a block cipher run per try, so
+    /// the controller (`owner`), which has heard every sender since its session opened, tries 2
+    /// and a node that may have joined late tries 2^8 (2^24 frames: 4.6 h at 1 kHz).
+    pub const fn new(check: Check, owner: bool, reference: u32) -> Self {
+        let tries = match (check, owner) {
+            (Check::Crc, _) => 1 << 12,
+            (Check::Mac, true) => 2,
+            (Check::Mac, false) => 1 << 8,
+        };
+        Self { reference, tries }
     }
 }
 
-/// Counter state of one identifier at the receiver.
+/// Slack on the session time a member knows, ms: it hears the time at 50 Hz, and a frame may
+/// wait in a queue.
+const TIME_SLACK_MS: u32 = 100;
+
+/// Counter state of one identifier at the receiver: the last accepted counter and the session
+/// time it was accepted at.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct E2eChecker {
     last: Option<u32>,
+    last_at_ms: u32,
 }
 
 impl E2eChecker {
     /// A checker that has heard nothing.
     pub const fn new() -> Self {
-        Self { last: None }
+        Self {
+            last: None,
+            last_at_ms: 0,
+        }
     }
 
-    /// Forgets the sequence (a new session starts every sender at zero).
+    /// Forgets the sequence (a new session restarts every sender).
     pub fn reset(&mut self) {
         self.last = None;
     }
@@ -206,53 +236,62 @@ impl E2eChecker {
     /// Places a received low counter in the sequence, verifies the frame at that full counter
     /// with `verify`, and advances the sequence when the frame is accepted.
     ///
-    /// Ahead by 1…2^15 − 1 is in sequence (the frames between are lost); the same counter is a
-    /// repeat; anything else is behind. Only a frame whose check holds at the counter so placed
-    /// is in sequence, so a replay that lands ahead by wrap-around fails its check.
+    /// Ahead by 1…2^15 − 1 is in sequence (the frames between are lost), unless more frames
+    /// would be lost than milliseconds have passed since the last accepted one: then the
+    /// sender restarted at the session time, and the sequence restarts (`Initial`). The same
+    /// counter with
+    /// a valid check is a repeat; behind by 1…2^15 with a valid check is out of sequence. A
+    /// frame that fits none of these is looked for as `search` says ([`Search`]): found, it
+    /// restarts the sequence (`Initial`); not found, its check failed.
     pub fn check(
         &mut self,
         low: u16,
-        tries: u32,
+        search: Search,
         mut verify: impl FnMut(u32) -> bool,
     ) -> E2eStatus {
-        let Some(last) = self.last else {
-            let found = (0..tries)
-                .map(|high| high << 16_u32 | u32::from(low))
-                .find(|full| verify(*full));
-            return match found {
-                Some(full) => {
-                    self.last = Some(full);
-                    E2eStatus::Initial
+        if let Some(last) = self.last {
+            let delta = low.wrapping_sub((last & 0xFFFF) as u16);
+            if delta == 0 {
+                if verify(last) {
+                    return E2eStatus::Repeated;
                 }
-                None => E2eStatus::CheckFailed,
-            };
-        };
-        let delta = low.wrapping_sub((last & 0xFFFF) as u16);
-        if delta == 0 {
-            return if verify(last) {
-                E2eStatus::Repeated
+            } else if delta < 0x8000 {
+                let full = last.saturating_add(u32::from(delta));
+                if verify(full) {
+                    let elapsed_ms = search.reference.saturating_sub(self.last_at_ms);
+                    let lost = u32::from(delta) - 1;
+                    self.accept(full, search.reference);
+                    return match lost {
+                        0 => E2eStatus::Ok,
+                        _ if lost > elapsed_ms.saturating_add(TIME_SLACK_MS) => E2eStatus::Initial,
+                        _ => E2eStatus::OkSomeLost { lost },
+                    };
+                }
             } else {
-                E2eStatus::CheckFailed
-            };
-        }
-        if delta < 0x8000 {
-            let full = last.wrapping_add(u32::from(delta));
-            if !verify(full) {
-                return E2eStatus::CheckFailed;
+                let behind = 0x1_0000 - u32::from(delta);
+                if last.checked_sub(behind).is_some_and(&mut verify) {
+                    return E2eStatus::WrongSequence;
+                }
             }
-            self.last = Some(full);
-            return match delta {
-                1 => E2eStatus::Ok,
-                _ => E2eStatus::OkSomeLost {
-                    lost: u32::from(delta) - 1,
-                },
-            };
         }
-        let behind = 0x1_0000 - u32::from(delta);
-        if verify(last.wrapping_sub(behind)) {
-            E2eStatus::WrongSequence
-        } else {
-            E2eStatus::CheckFailed
+        let first_high = ((search.reference >> 16_u32) + 1).min(0xFFFF);
+        let floor = self.last.map_or(0, |last| last >> 16_u32);
+        let found = (0..search.tries)
+            .map_while(|n| first_high.checked_sub(n).filter(|high| *high >= floor))
+            .map(|high| high << 16_u32 | u32::from(low))
+            .filter(|full| self.last.is_none_or(|last| *full > last))
+            .find(|full| verify(*full));
+        match found {
+            Some(full) => {
+                self.accept(full, search.reference);
+                E2eStatus::Initial
+            }
+            None => E2eStatus::CheckFailed,
         }
+    }
+
+    fn accept(&mut self, counter: u32, at_ms: u32) {
+        self.last = Some(counter);
+        self.last_at_ms = at_ms;
     }
 }

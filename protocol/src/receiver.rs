@@ -1,12 +1,12 @@
 //! The receiving side of the bus: verify, sequence-check, decode and count every rejection.
 
-use crate::e2e::{self, join_tries, E2eChecker, E2eStatus, Freshness, HEADER_LEN};
+use crate::e2e::{self, E2eChecker, E2eStatus, Freshness, Search, HEADER_LEN};
 use crate::error::{DecodeError, RejectCause};
 use crate::id::MessageId;
 use crate::message::{decode_frame, protection_of, AnyMessage};
 use crate::msg::{Announce, RejectCounters, CLASSIC_LATCH_LEN};
 use crate::session::{Key, Session};
-use crate::units::{Count, Epoch, WireVersion};
+use crate::units::{Count, SessionTime, WireVersion};
 
 /// A frame the receiver accepted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,7 +31,6 @@ pub struct Accepted {
 pub struct Receiver {
     session: Session,
     owner: bool,
-    announce_last: Option<u16>,
     checkers: [E2eChecker; MessageId::ALL.len()],
     counters: RejectCounters,
 }
@@ -51,7 +50,6 @@ impl Receiver {
         Self {
             session,
             owner,
-            announce_last: None,
             checkers: [E2eChecker::new(); MessageId::ALL.len()],
             counters: RejectCounters {
                 rejected: [Count::ZERO; RejectCause::ALL.len()],
@@ -63,6 +61,14 @@ impl Receiver {
     /// The session this node is in (or not yet): what its own frames are sealed under.
     pub const fn session(&self) -> &Session {
         &self.session
+    }
+
+    /// The controller's receiver: its session time now, against which it places counters.
+    /// A member's time comes from the announcements it hears.
+    pub fn set_time(&mut self, time: SessionTime) {
+        if self.owner {
+            self.session.set_time(time);
+        }
     }
 
     /// Accepts or rejects one frame. A rejection is counted before it is returned.
@@ -127,7 +133,8 @@ impl Receiver {
                 .checkers
                 .get_mut(id.index())
                 .ok_or(DecodeError::UnknownId(raw_id))?;
-            checker.check(low, join_tries(protection.check), verify)
+            let search = Search::new(protection.check, self.owner, self.session.time().ms());
+            checker.check(low, search, verify)
         } else if verify(u32::from(low)) {
             E2eStatus::Initial
         } else {
@@ -138,55 +145,41 @@ impl Receiver {
         }
         let message = decode_frame(raw_id, data)?.message;
         if let AnyMessage::Announce(announce) = message {
-            self.on_announce(raw_id, low, &announce)?;
+            self.on_announce(raw_id, &announce)?;
         }
         Ok(Accepted { message, status })
     }
 
     /// Joins, moves to, or refuses the session an authentic announcement opens.
-    fn on_announce(
-        &mut self,
-        raw_id: u16,
-        low: u16,
-        announce: &Announce,
-    ) -> Result<(), DecodeError> {
+    fn on_announce(&mut self, raw_id: u16, announce: &Announce) -> Result<(), DecodeError> {
         if announce.version != WireVersion::THIS {
             return Err(DecodeError::WireVersion {
                 theirs: announce.version.raw(),
             });
         }
-        let joined = self.session.epoch();
-        match joined {
+        match self.session.epoch() {
             Some(epoch) if announce.epoch < epoch => Err(DecodeError::StaleSession { id: raw_id }),
             Some(epoch) if announce.epoch == epoch => {
-                if self.owner {
-                    return Ok(());
-                }
-                let delta = self.announce_last.map(|last| low.wrapping_sub(last));
-                match delta {
-                    Some(0) => Err(DecodeError::Repeated { id: raw_id }),
-                    Some(delta) if delta >= 0x8000 => {
-                        Err(DecodeError::WrongSequence { id: raw_id })
-                    }
-                    _ => {
-                        self.announce_last = Some(low);
-                        Ok(())
-                    }
+                // A controller waiting for its first tick repeats its announcement at one
+                // time; only an earlier time is a replay.
+                let last = self.session.time();
+                if self.owner || announce.time == last {
+                    Ok(())
+                } else if announce.time > last {
+                    self.session.set_time(announce.time);
+                    Ok(())
+                } else {
+                    Err(DecodeError::WrongSequence { id: raw_id })
                 }
             }
             _ if self.owner => Err(DecodeError::StaleSession { id: raw_id }),
             _ => {
-                self.join(announce.epoch, low);
+                self.session.join(announce.epoch, announce.time);
+                for checker in &mut self.checkers {
+                    checker.reset();
+                }
                 Ok(())
             }
-        }
-    }
-
-    fn join(&mut self, epoch: Epoch, announce_low: u16) {
-        self.session.join(epoch);
-        self.announce_last = Some(announce_low);
-        for checker in &mut self.checkers {
-            checker.reset();
         }
     }
 

@@ -1,4 +1,4 @@
-//! The sending side of the bus: one counter per identifier, restarted with every session.
+//! The sending side of the bus: one counter per identifier, started at the session time.
 
 use crate::codec::EncodeError;
 use crate::frame::Frame;
@@ -9,8 +9,9 @@ use crate::node::NodeId;
 use crate::session::{Epoch, Session, TEST_KEY};
 
 /// Seals a node's messages: hands out each identifier's full counter and protects the frame
-/// under the node's session. When the session changes (the controller restarted), every
-/// counter starts again at zero, as the receivers expect.
+/// under the node's session. In every session it is in, a sender starts all its counters at the
+/// session time of its first frame there (see [`crate::session`]), so that a node restarted in
+/// the same session sends counters above those of its previous life.
 #[derive(Debug, Clone)]
 pub struct Sender {
     epoch: Option<Epoch>,
@@ -32,35 +33,25 @@ impl Sender {
         }
     }
 
-    /// A sender whose next frame on every identifier carries `counter`, in `session`: for a
-    /// node that resumes a session it was in before (the teleop's state file).
-    pub const fn resuming(session: &Session, counter: u32) -> Self {
-        Self {
-            epoch: session.epoch(),
-            counters: [counter; MessageId::ALL.len()],
-        }
-    }
-
     /// The frame for `message` under `session`, with the next counter of its identifier.
     /// A message bound to a session fails with [`EncodeError::NoSession`] until the node has
     /// joined one, and uses up no counter.
     pub fn seal(&mut self, session: &Session, message: &AnyMessage) -> Result<Frame, EncodeError> {
+        let now = session.time().ms();
         if session.epoch() != self.epoch {
             self.epoch = session.epoch();
-            self.counters = [0; MessageId::ALL.len()];
+            self.counters = [now; MessageId::ALL.len()];
         }
         let slot = self
             .counters
             .get_mut(message.id().index())
             .ok_or(EncodeError::TooLarge)?;
+        if message.id() == MessageId::EStop {
+            *slot = (*slot).max(now);
+        }
         let frame = message.encode(session, *slot)?;
         *slot = slot.wrapping_add(1);
         Ok(frame)
-    }
-
-    /// The highest counter handed out so far on any identifier, for a node that persists it.
-    pub fn high_water(&self) -> u32 {
-        self.counters.iter().copied().max().unwrap_or(0)
     }
 }
 

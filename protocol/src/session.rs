@@ -3,13 +3,21 @@
 //!
 //! The controller owns the session. At every start it takes an **epoch** strictly greater than
 //! any it used before (persisted: the MCU's backup register, firmware-host's state file) and
-//! announces it with the wire version ([`Announce`](crate::Announce), authenticated). Every
-//! other node joins by hearing the announcement, resets its send counters to zero, and from
-//! then on binds each frame to the session: the frame's check value covers the epoch and the
-//! frame's full 32-bit counter, of which only the low 16 bits travel. A frame recorded in an
-//! earlier session fails its check in this one; a frame recorded earlier in this session is
-//! behind the receiver's counter, or (if it is 2^16 frames old or more) fails its check
-//! because its full counter differs. Replays are refused, not merely rare.
+//! announces it with the wire version and its **session time** (ms since the session opened)
+//! ([`Announce`](crate::Announce), authenticated, at 50 Hz). Every other node joins by hearing
+//! the announcement and from then on binds each frame to the session: the frame's check value
+//! covers the epoch and the frame's full 32-bit counter, of which only the low 16 bits travel.
+//!
+//! A sender starts its counters at the session time it (re)joins at and counts one per frame,
+//! so at up to one frame per millisecond on an identifier its counter never passes the session
+//! time: a node that restarts in the same session starts above everything it sent before, and
+//! a receiver that joins late, or misses 2^15 frames, finds the counter within a few high
+//! halves of the session time ([`Search`](crate::e2e::Search)). A frame recorded in an earlier
+//! session fails its check in this one; a frame recorded earlier in this session is at or behind
+//! the receiver's counter, and a receiver only ever accepts a counter after the last it
+//! accepted. Replays are refused, not merely rare. The E-stop **release** counts with the
+//! session time itself (the greater of its next counter and the time), so that two operators
+//! releasing on one identifier both stay ahead.
 //!
 //! Operator commands, E-stop releases, drive commands and the announcement carry a truncated
 //! CMAC-AES-128 as their check value, so that a node without the key cannot command motion or
@@ -19,7 +27,7 @@
 //! One frame is bound to nothing: the E-stop **latch**, which anyone may send at any time with
 //! a fixed content (an E-stop panel's constant frame, an operator's `cansend`).
 
-pub use crate::units::Epoch;
+pub use crate::units::{Epoch, SessionTime};
 
 /// The wire version this build speaks. Nodes refuse an announcement of another version: the
 /// layouts differ, and a node that guessed would misread every frame.
@@ -97,11 +105,13 @@ impl Key {
     }
 }
 
-/// What a node knows of the bus session: the key, and the epoch once it has joined.
+/// What a node knows of the bus session: the key, the epoch once it has joined, and the
+/// session time (the controller's own, or the latest it announced).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Session {
     key: Key,
     epoch: Option<Epoch>,
+    time: SessionTime,
 }
 
 impl Session {
@@ -110,13 +120,18 @@ impl Session {
         Session {
             key,
             epoch: Some(epoch),
+            time: SessionTime::from_ms(0),
         }
     }
 
     /// A node that has not heard the controller yet: it can send the E-stop latch and nothing
     /// bound to a session until it joins.
     pub const fn unjoined(key: Key) -> Session {
-        Session { key, epoch: None }
+        Session {
+            key,
+            epoch: None,
+            time: SessionTime::from_ms(0),
+        }
     }
 
     /// The key.
@@ -129,7 +144,22 @@ impl Session {
         self.epoch
     }
 
-    pub(crate) fn join(&mut self, epoch: Epoch) {
+    /// The session time: the controller's own, or the latest it announced.
+    pub const fn time(&self) -> SessionTime {
+        self.time
+    }
+
+    /// The same session `time` into it.
+    pub const fn at(self, time: SessionTime) -> Session {
+        Session { time, ..self }
+    }
+
+    pub(crate) fn join(&mut self, epoch: Epoch, time: SessionTime) {
         self.epoch = Some(epoch);
+        self.time = time;
+    }
+
+    pub(crate) fn set_time(&mut self, time: SessionTime) {
+        self.time = time;
     }
 }

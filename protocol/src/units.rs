@@ -62,6 +62,12 @@ wire_scalar!(
     Epoch(u32) = U32, exp10 0, unit "", raw 0, u32::MAX
 );
 wire_scalar!(
+    /// Time since the controller opened its session ([`crate::session`]), ms, `u32`: the
+    /// reference a node places counters against, and what a (re)joining sender starts its
+    /// counters at. A session lasts at most 2^32 ms (49.7 days).
+    SessionTime(u32) = U32, exp10 -3, unit "s", raw 0, u32::MAX
+);
+wire_scalar!(
     /// Version of the wire contract ([`crate::session::WIRE_VERSION`]). 1, `u8`.
     WireVersion(u8) = U8, exp10 0, unit "", raw 0, u8::MAX
 );
@@ -98,6 +104,18 @@ impl Epoch {
             Some(raw) => Some(Self(raw)),
             None => None,
         }
+    }
+}
+
+impl SessionTime {
+    /// `ms` milliseconds into the session.
+    pub const fn from_ms(ms: u32) -> Self {
+        Self(ms)
+    }
+
+    /// Milliseconds into the session.
+    pub const fn ms(self) -> u32 {
+        self.0
     }
 }
 

@@ -2,33 +2,41 @@
 //! layout of the header.
 
 use proptest::prelude::*;
-use protocol::e2e::{check_value, header, join_tries, protect, Freshness, HEADER_LEN};
+use protocol::e2e::{check_value, header, protect, Freshness, Search, HEADER_LEN};
 use protocol::{
-    AnyMessage, Check, E2eChecker, E2eStatus, Epoch, Key, Receiver, Session, Sync, Tick, TEST_KEY,
+    AnyMessage, Check, E2eChecker, E2eStatus, Epoch, Key, Receiver, Session, SessionTime, Sync,
+    Tick, TEST_KEY,
 };
 
+/// The receiver's session time when `checker` is offered a genuine frame of counter `sent`: a
+/// sender's counter never passes the session time, so the receiver's time is at or past both
+/// `sent` and every counter it accepted before.
+fn now_for(checker: &E2eChecker, sent: u32) -> u32 {
+    checker.last().map_or(sent, |last| last.max(sent))
+}
+
 /// Offers `checker` a frame of a genuine sender whose full counter is `sent`: its check value
-/// holds at that counter and at no other, as a check that covers the full counter does.
+/// holds at that counter and at no other, as a check that covers the full counter does. The
+/// receiver searches as the controller does for a CMAC (the fewest tries).
 fn offer(checker: &mut E2eChecker, sent: u32) -> E2eStatus {
-    checker.check(sent as u16, 1, |full| full == sent)
+    let search = Search::new(Check::Mac, true, now_for(checker, sent));
+    checker.check(sent as u16, search, |full| full == sent)
 }
 
 /// Offers `checker` a frame whose check holds at no counter: corrupted, forged, or from
-/// another session.
+/// another session. The receiver searches as widely as any does.
 fn offer_forged(checker: &mut E2eChecker, low: u16) -> E2eStatus {
-    checker.check(low, 256, |_| false)
+    let search = Search {
+        reference: u32::MAX,
+        tries: 1 << 12,
+    };
+    checker.check(low, search, |_| false)
 }
 
 fn checker_after(counters: &[u32]) -> E2eChecker {
     let mut checker = E2eChecker::new();
     for &c in counters {
-        let tries = (c >> 16) + 1;
-        assert!(
-            checker
-                .check(c as u16, tries, |full| full == c)
-                .is_accepted(),
-            "setup counter {c}"
-        );
+        assert!(offer(&mut checker, c).is_accepted(), "setup counter {c}");
     }
     checker
 }
@@ -76,22 +84,47 @@ fn a_step_backwards_is_wrong_sequence() {
 }
 
 /// Wire version 1 resynchronised on two consecutive frames, which let a replay of two
-/// recorded frames take over the sequence. Now only a new session restarts it.
+/// recorded frames take over the sequence. Now frames behind the sequence never move it, however
+/// many there are in a row.
 #[test]
-fn a_sender_restarted_within_the_session_is_not_resynchronised() {
+fn frames_behind_the_sequence_never_take_it_over() {
     let mut checker = checker_after(&[5000, 5001]);
-    for restarted in 0..100 {
+    for replayed in 0..100 {
         assert_eq!(
-            offer(&mut checker, restarted),
+            offer(&mut checker, replayed),
             E2eStatus::WrongSequence,
-            "frame {restarted} of the restarted sender"
+            "replayed frame {replayed}"
         );
     }
     assert_eq!(checker.last(), Some(5001));
-    // A new session: the receiver forgets the sequence and the sender starts at zero.
+    // A new session: the receiver forgets the sequence and the sender starts at the session
+    // time, here the start.
     checker.reset();
     assert_eq!(offer(&mut checker, 0), E2eStatus::Initial);
     assert_eq!(offer(&mut checker, 1), E2eStatus::Ok);
+}
+
+/// A sender restarted within the session starts its counters at the session time, which is
+/// past every counter it sent before: it is in sequence (the frames between count as lost), or,
+/// 2^15 or more ahead, found by the search.
+#[test]
+fn a_sender_restarted_within_the_session_is_taken_from_its_first_frame() {
+    let mut checker = checker_after(&[5000, 5001]);
+    // Restarted at session time 5100.
+    assert_eq!(
+        offer(&mut checker, 5100),
+        E2eStatus::OkSomeLost { lost: 98 }
+    );
+    assert_eq!(offer(&mut checker, 5101), E2eStatus::Ok);
+    // Restarted again, 100 s later: 2^15 and more ahead.
+    let restart = 105_101;
+    assert_eq!(offer(&mut checker, restart), E2eStatus::Initial);
+    assert_eq!(offer(&mut checker, restart + 1), E2eStatus::Ok);
+    // Its earlier lives' frames stay behind.
+    for old in [5001, 5100, 5101, restart - 0x8000, restart] {
+        assert!(!offer(&mut checker, old).is_accepted(), "{old}");
+    }
+    assert_eq!(checker.last(), Some(restart + 1));
 }
 
 #[test]
@@ -119,38 +152,151 @@ fn the_counter_wraps_into_the_high_half() {
 
 #[test]
 fn a_first_frame_is_looked_for_in_as_many_high_halves_as_allowed() {
+    // From the half after the receiver's time's (5 + 1) downward.
     let sent = 3 << 16 | 7;
+    let now = 5 << 16 | 0x1234;
     let mut checker = E2eChecker::new();
+    let search = |tries| Search {
+        reference: now,
+        tries,
+    };
     assert_eq!(
-        checker.check(7, 3, |full| full == sent),
+        checker.check(7, search(3), |full| full == sent),
         E2eStatus::CheckFailed
     );
     assert_eq!(checker.last(), None);
-    assert_eq!(checker.check(7, 4, |full| full == sent), E2eStatus::Initial);
-    assert_eq!(checker.last(), Some(sent));
-    assert_eq!(join_tries(Check::Crc), 256);
     assert_eq!(
-        join_tries(Check::Mac),
-        1,
-        "a forged first frame costs one CMAC"
+        checker.check(7, search(4), |full| full == sent),
+        E2eStatus::Initial
     );
+    assert_eq!(checker.last(), Some(sent));
+    // A counter more than one half past the receiver's time is not looked for.
+    let mut checker = E2eChecker::new();
+    let early = Search {
+        reference: 1 << 16,
+        tries: 1 << 12,
+    };
+    assert_eq!(
+        checker.check(7, early, |full| full == sent),
+        E2eStatus::CheckFailed
+    );
+    assert_eq!(Search::new(Check::Crc, false, now).tries, 1 << 12);
+    assert_eq!(Search::new(Check::Crc, true, now).tries, 1 << 12);
+    assert_eq!(Search::new(Check::Mac, false, now).tries, 1 << 8);
+    assert_eq!(
+        Search::new(Check::Mac, true, now).tries,
+        2,
+        "the controller spends at most two CMACs looking"
+    );
+    assert_eq!(Search::new(Check::Mac, true, now).reference, now);
 }
 
 #[test]
-fn half_the_counter_range_ahead_is_behind() {
+fn half_the_counter_range_ahead_is_found_by_the_search() {
     let mut checker = checker_after(&[10]);
     assert_eq!(
         offer(&mut checker, 10 + 0x7FFF),
         E2eStatus::OkSomeLost { lost: 0x7FFE }
     );
-    // 2^15 ahead reads as 2^15 behind, where the check does not hold.
+    // 2^15 ahead reads as 2^15 behind, where the check does not hold; the receiver, whose time
+    // has reached the frame's counter, finds it in the search and restarts the sequence there.
     let mut checker = checker_after(&[10]);
-    assert_eq!(offer(&mut checker, 10 + 0x8000), E2eStatus::CheckFailed);
+    assert_eq!(offer(&mut checker, 10 + 0x8000), E2eStatus::Initial);
+    assert_eq!(checker.last(), Some(10 + 0x8000));
+    // A receiver whose time is more than a half behind the frame does not find it.
+    let mut checker = checker_after(&[10]);
+    let sent = 10 + 0x2_8000;
+    let behind = Search::new(Check::Mac, true, 10);
+    assert_eq!(
+        checker.check(sent as u16, behind, |full| full == sent),
+        E2eStatus::CheckFailed
+    );
     assert_eq!(checker.last(), Some(10));
     // A genuine frame 2^15 behind is stale; one 2^15 + 1 behind reads as ahead and fails.
     let mut checker = checker_after(&[0x9000]);
     assert_eq!(offer(&mut checker, 0x1000), E2eStatus::WrongSequence);
     assert_eq!(offer(&mut checker, 0x0FFF), E2eStatus::CheckFailed);
+}
+
+/// The search never goes back to or behind the last accepted counter: a frame one or more
+/// halves old with the low half of a counter ahead is not found, however many halves are
+/// tried.
+#[test]
+fn the_search_never_finds_a_counter_at_or_behind_the_last_accepted() {
+    let last = 9 << 16 | 0x0100;
+    for sent in [last, last - 1, 8 << 16 | 0x0200, 3 << 16 | 0x0100, 0x0100] {
+        let mut checker = checker_after(&[last]);
+        let search = Search {
+            reference: u32::MAX,
+            tries: 1 << 16,
+        };
+        assert_eq!(
+            checker
+                .check(sent as u16, search, |full| full == sent)
+                .is_accepted(),
+            false,
+            "{sent:#x}"
+        );
+        assert_eq!(checker.last(), Some(last));
+    }
+}
+
+/// A CMAC costs a block cipher run per try: a frame forged without the key costs the
+/// controller one try where the sequence places it and at most two in the search.
+#[test]
+fn a_forged_cmac_costs_the_controller_at_most_four_verifications() {
+    let epoch = Some(Epoch::new(12));
+    let data_id = 0xC200;
+    let forger = Key([0x66; 16]);
+    let payload = *b"drive!";
+    let now = 7 << 16 | 0x4000;
+    let genuine: Vec<u32> = (now - 40..now - 20).collect();
+    let mut worst = 0;
+    for fresh in [true, false] {
+        for counter in [
+            0,
+            1,
+            now - 21,
+            now - 20,
+            now - 19,
+            now - 30,
+            now,
+            now + 0x8000,
+            !0,
+        ] {
+            let mut checker = if fresh {
+                E2eChecker::new()
+            } else {
+                checker_after(&genuine)
+            };
+            let before = checker.last();
+            let freshness = Freshness {
+                data_id,
+                epoch,
+                counter,
+            };
+            let message = protected(Check::Mac, &forger, &freshness, &payload);
+            let (sent, low) = header(&message).unwrap();
+            let mut runs = 0;
+            let status = checker.check(low, Search::new(Check::Mac, true, now), |counter| {
+                runs += 1;
+                let at = Freshness {
+                    data_id,
+                    epoch,
+                    counter,
+                };
+                check_value(Check::Mac, &TEST_KEY, &at, &payload) == sent
+            });
+            assert_eq!(status, E2eStatus::CheckFailed, "{counter:#x}");
+            assert_eq!(checker.last(), before);
+            assert!(runs <= 1 + 1 + 2, "{counter:#x}: {runs} CMACs");
+            if fresh {
+                assert!(runs <= 2, "no sequence: the search alone, {runs} CMACs");
+            }
+            worst = worst.max(runs);
+        }
+    }
+    assert_eq!(worst, 3, "one try in the sequence, two in the search");
 }
 
 #[test]
@@ -188,7 +334,7 @@ fn receive_bytes(
     message: &[u8],
 ) -> E2eStatus {
     let (sent, low) = header(message).unwrap();
-    checker.check(low, join_tries(check), |counter| {
+    checker.check(low, Search::new(check, false, 0), |counter| {
         let freshness = Freshness {
             data_id,
             epoch,
@@ -363,7 +509,7 @@ fn too_short_messages_have_no_header() {
 
 #[test]
 fn the_receiver_counts_frames_lost_in_a_burst() {
-    let session = Session::owned(TEST_KEY, Epoch::new(3));
+    let session = Session::owned(TEST_KEY, Epoch::new(3)).at(SessionTime::from_ms(40));
     let mut receiver = Receiver::owner(session);
     let sync = |counter: u32| {
         AnyMessage::Sync(Sync {
@@ -436,10 +582,7 @@ fn history() -> impl Strategy<Value = (u32, Vec<u32>)> {
 /// A checker that accepted the frames of `history`, and the last counter.
 fn replay_history(start: u32, gaps: &[u32]) -> (E2eChecker, u32) {
     let mut checker = E2eChecker::new();
-    assert_eq!(
-        checker.check(start as u16, (start >> 16) + 1, |full| full == start),
-        E2eStatus::Initial
-    );
+    assert_eq!(offer(&mut checker, start), E2eStatus::Initial);
     let mut last = start;
     for &gap in gaps {
         last += gap;
@@ -488,16 +631,41 @@ proptest! {
         prop_assert_eq!(offer(&mut checker, last + 1), E2eStatus::Ok);
     }
 
-    /// A genuine frame half the counter range or more ahead cannot be placed: refused, and the
-    /// sequence is unchanged.
+    /// A genuine frame half the counter range or more ahead (a gap of 2^15 frames or more) is
+    /// found when the receiver's time has reached it, as a sender's counter never passes the
+    /// session time: the sequence restarts there.
     #[test]
-    fn a_frame_half_the_range_or_more_ahead_is_refused(
+    fn a_frame_half_the_range_or_more_ahead_is_found_at_its_time(
         (start, gaps) in history(),
         ahead in prop_oneof![0x8000_u32..0x8100, 0xFF00_u32..0x1_0100, 0x8000_u32..0x1000_0000],
     ) {
         let (mut checker, last) = replay_history(start, &gaps);
-        prop_assert_eq!(offer(&mut checker, last + ahead), E2eStatus::CheckFailed);
-        prop_assert_eq!(checker.last(), Some(last));
+        prop_assert_eq!(offer(&mut checker, last + ahead), E2eStatus::Initial);
+        prop_assert_eq!(checker.last(), Some(last + ahead));
+        prop_assert_eq!(offer(&mut checker, last + ahead + 1), E2eStatus::Ok);
+    }
+
+    /// The same frame, at a receiver whose time is `now`: found exactly when its high half is
+    /// among the controller's two tries (the half of `now` and the next); refused otherwise,
+    /// and the sequence unchanged.
+    #[test]
+    fn a_frame_half_the_range_or_more_ahead_is_found_only_near_the_receivers_time(
+        (start, gaps) in history(),
+        ahead in prop_oneof![0x8000_u32..0x8100, 0xFF00_u32..0x1_0100, 0x8000_u32..0x1000_0000],
+        lead in 0_u32..0x4_0000,
+    ) {
+        let (mut checker, last) = replay_history(start, &gaps);
+        let sent = last + ahead;
+        let now = (last + lead).min(sent + 0x2_0000);
+        let status = checker.check(sent as u16, Search::new(Check::Mac, true, now), |full| full == sent);
+        let near = sent >> 16 == now >> 16 || sent >> 16 == (now >> 16) + 1;
+        if near {
+            prop_assert_eq!(status, E2eStatus::Initial);
+            prop_assert_eq!(checker.last(), Some(sent));
+        } else {
+            prop_assert_eq!(status, E2eStatus::CheckFailed);
+            prop_assert_eq!(checker.last(), Some(last));
+        }
     }
 
     /// A frame whose check holds at no counter never enters or moves a sequence.
@@ -505,22 +673,34 @@ proptest! {
     fn a_forged_frame_never_moves_the_sequence(
         (start, gaps) in history(),
         low in any::<u16>(),
+        reference in any::<u32>(),
         tries in 0_u32..300,
     ) {
         let mut fresh = E2eChecker::new();
-        prop_assert_eq!(fresh.check(low, tries, |_| false), E2eStatus::CheckFailed);
+        prop_assert_eq!(
+            fresh.check(low, Search { reference, tries }, |_| false),
+            E2eStatus::CheckFailed
+        );
         prop_assert_eq!(fresh.last(), None);
         let (mut checker, last) = replay_history(start, &gaps);
         prop_assert_eq!(offer_forged(&mut checker, low), E2eStatus::CheckFailed);
         prop_assert_eq!(checker.last(), Some(last));
     }
 
-    /// A first frame is found exactly when its high half is among those tried.
+    /// A first frame is found exactly when its high half is among those tried: the half after
+    /// the receiver's time's and the `tries − 1` below it.
     #[test]
-    fn a_first_frame_is_found_within_its_tries(sent in 0_u32..(600 << 16), tries in 0_u32..600) {
+    fn a_first_frame_is_found_within_its_tries(
+        sent in 0_u32..(600 << 16),
+        reference in 0_u32..(600 << 16),
+        tries in 0_u32..600,
+    ) {
         let mut checker = E2eChecker::new();
-        let status = checker.check(sent as u16, tries, |full| full == sent);
-        if sent >> 16 < tries {
+        let search = Search { reference, tries };
+        let status = checker.check(sent as u16, search, |full| full == sent);
+        let first = (reference >> 16) + 1;
+        let high = sent >> 16;
+        if high <= first && first - high < tries {
             prop_assert_eq!(status, E2eStatus::Initial);
             prop_assert_eq!(checker.last(), Some(sent));
         } else {

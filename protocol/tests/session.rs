@@ -6,7 +6,7 @@ mod common;
 
 use std::sync::OnceLock;
 
-use common::{announce_frame, joined_member};
+use common::{announce_frame, announce_frame_at, joined_member, member_at, owner_at};
 use proptest::prelude::*;
 use protocol::e2e::HEADER_LEN;
 use protocol::*;
@@ -14,8 +14,9 @@ use protocol::*;
 // ------------------------------------------------------------------------------------------
 // A recorded bus.
 
-/// Control ticks of the recorded run. The wheel command and the wheel feedback go out every
-/// tick, so each of their ids carries more than 2^16 frames and their low counters wrap.
+/// Control ticks of the recorded run, one per millisecond of session time. The wheel command and
+/// the wheel feedback go out every tick, so each of their ids carries more than 2^16 frames and
+/// their low counters wrap.
 const TICKS: u32 = 70_000;
 /// The session the run is recorded in, and the one the controller opens when it restarts.
 const OLD: Epoch = Epoch::new(1_000);
@@ -64,6 +65,9 @@ struct Node {
     id: NodeId,
     rx: Receiver,
     tx: Sender,
+    /// The session time of its first frame in the present session, where all its counters
+    /// start.
+    start: Option<u32>,
 }
 
 impl Node {
@@ -72,6 +76,16 @@ impl Node {
             id,
             rx: Receiver::member(TEST_KEY),
             tx: Sender::new(),
+            start: None,
+        }
+    }
+
+    fn controller(epoch: Epoch) -> Node {
+        Node {
+            id: NodeId::Controller,
+            rx: Receiver::owner(Session::owned(TEST_KEY, epoch)),
+            tx: Sender::new(),
+            start: None,
         }
     }
 }
@@ -81,26 +95,25 @@ impl Node {
 #[derive(Debug, Clone)]
 struct Bus {
     nodes: Vec<Node>,
-    /// The next counter of each identifier in the present session (each has one sender).
-    next: [u32; MessageId::ALL.len()],
+    /// The controller's session time, ms.
+    time: u32,
+    /// The next counter of each identifier in the present session (each has one sender), once
+    /// it has sent on it.
+    next: [Option<u32>; MessageId::ALL.len()],
     log: Vec<Logged>,
 }
 
 impl Bus {
     /// The controller opens `epoch` and announces it; the teleop and the wheel drive join.
     fn start(epoch: Epoch) -> Bus {
-        let controller = Node {
-            id: NodeId::Controller,
-            rx: Receiver::owner(Session::owned(TEST_KEY, epoch)),
-            tx: Sender::new(),
-        };
         let mut bus = Bus {
             nodes: vec![
-                controller,
+                Node::controller(epoch),
                 Node::member(NodeId::Teleop),
                 Node::member(NodeId::WheelDrive),
             ],
-            next: [0; MessageId::ALL.len()],
+            time: 0,
+            next: [None; MessageId::ALL.len()],
             log: Vec::new(),
         };
         bus.announce();
@@ -108,25 +121,33 @@ impl Bus {
         bus
     }
 
-    /// The controller restarts into `epoch`: a new owner and sender; the members hear the
-    /// announcement and move.
+    /// The controller restarts into `epoch`: a new owner and sender at session time 0; the
+    /// members hear the announcement and move.
     fn restart(&mut self, epoch: Epoch) {
-        self.nodes[0] = Node {
-            id: NodeId::Controller,
-            rx: Receiver::owner(Session::owned(TEST_KEY, epoch)),
-            tx: Sender::new(),
-        };
-        self.next = [0; MessageId::ALL.len()];
+        self.nodes[0] = Node::controller(epoch);
+        for node in &mut self.nodes {
+            node.start = None;
+        }
+        self.time = 0;
+        self.next = [None; MessageId::ALL.len()];
         self.announce();
         self.assert_all_in(epoch);
     }
 
-    /// A node joins: it hears the controller's next announcement.
+    /// A node joins a millisecond later: it hears the controller's next announcement.
     fn join(&mut self, id: NodeId) {
         self.nodes.push(Node::member(id));
+        self.set_time(self.time + 1);
         self.announce();
         let epoch = self.nodes[0].rx.session().epoch();
         assert_eq!(self.nodes.last().unwrap().rx.session().epoch(), epoch);
+    }
+
+    /// The controller's clock reads `time`.
+    fn set_time(&mut self, time: u32) {
+        assert!(time >= self.time, "session time runs forward");
+        self.time = time;
+        self.nodes[0].rx.set_time(SessionTime::from_ms(time));
     }
 
     fn assert_all_in(&self, epoch: Epoch) {
@@ -136,14 +157,14 @@ impl Bus {
     }
 
     fn announce(&mut self) {
-        let epoch = self.nodes[0].rx.session().epoch().unwrap();
-        self.send(
-            NodeId::Controller,
-            AnyMessage::Announce(Announce {
-                version: WireVersion::THIS,
-                epoch,
-            }),
-        );
+        let session = self.nodes[0].rx.session();
+        assert_eq!(session.time().ms(), self.time);
+        let announce = AnyMessage::Announce(Announce {
+            version: WireVersion::THIS,
+            epoch: session.epoch().unwrap(),
+            time: session.time(),
+        });
+        self.send(NodeId::Controller, announce);
     }
 
     /// `from` seals `message` under its session and sends it.
@@ -152,9 +173,16 @@ impl Bus {
         let session = *node.rx.session();
         let frame = node.tx.seal(&session, &message).unwrap();
         let epoch = session.epoch();
+        // A sender's counters all start at the session time of its first frame in the session
+        // and count one per frame on each identifier; the E-stop's never falls behind the time.
+        let now = session.time().ms();
+        let start = *node.start.get_or_insert(now);
         let slot = &mut self.next[message.id().index()];
-        let counter = *slot;
-        *slot += 1;
+        let mut counter = slot.unwrap_or(start);
+        if message.id() == MessageId::EStop {
+            counter = counter.max(now);
+        }
+        *slot = Some(counter + 1);
         assert_eq!(
             decode_frame(frame.id(), frame.data()).unwrap().counter,
             counter as u16,
@@ -184,15 +212,16 @@ impl Bus {
         self.log.push(logged);
     }
 
-    /// The robot's traffic of control ticks `ticks`.
-    fn run(&mut self, ticks: std::ops::Range<u32>) {
-        for t in ticks {
+    /// The robot's traffic of the next `ticks` control ticks, one a millisecond.
+    fn run(&mut self, ticks: u32) {
+        for t in self.time + 1..=self.time + ticks {
             self.tick(t);
         }
     }
 
     fn tick(&mut self, t: u32) {
         use NodeId::{Controller, Teleop, WheelDrive};
+        self.set_time(t);
         let small = |x: u32| (x % 2000) as i16 - 1000;
         if t % 100 == 0 {
             self.announce();
@@ -289,7 +318,7 @@ fn recorded() -> &'static Recorded {
     static RECORDED: OnceLock<Recorded> = OnceLock::new();
     RECORDED.get_or_init(|| {
         let mut bus = Bus::start(OLD);
-        bus.run(0..TICKS);
+        bus.run(TICKS);
         let log = std::mem::take(&mut bus.log);
         let mut last = [None; MessageId::ALL.len()];
         for logged in log.iter().filter(|l| !l.is_latch()) {
@@ -299,7 +328,7 @@ fn recorded() -> &'static Recorded {
 
         bus.restart(NEW);
         bus.join(NodeId::LegDriveFl);
-        bus.run(0..300);
+        bus.run(300);
         bus.join(NodeId::LegDriveFr);
         bus.log.clear();
         Recorded {
@@ -320,13 +349,14 @@ fn expected_later(logged: &Logged) -> Result<(), DecodeError> {
     let id = logged.frame.id();
     let last = recorded().last[logged.id().index()].unwrap();
     if logged.id() == MessageId::Announce {
-        // Announcements are ordered by their low counter within the epoch.
-        let delta = (logged.counter as u16).wrapping_sub(last as u16);
-        assert!(
-            delta == 0 || delta >= 0x8000,
-            "fixture: announcements within 2^15"
-        );
-        return Err(if delta == 0 {
+        // Announcements are ordered by their session time within the epoch, and the controller
+        // announces later times with greater counters.
+        let time = match decode_frame(id, logged.frame.data()).unwrap().message {
+            AnyMessage::Announce(announce) => announce.time,
+            other => panic!("{other:?}"),
+        };
+        assert_eq!(time.ms() / 100, logged.counter, "fixture: one a 100 ms");
+        return Err(if logged.counter == last {
             DecodeError::Repeated { id }
         } else {
             DecodeError::WrongSequence { id }
@@ -336,7 +366,7 @@ fn expected_later(logged: &Logged) -> Result<(), DecodeError> {
         0 => DecodeError::Repeated { id },
         1..=0x8000 => DecodeError::WrongSequence { id },
         // From 2^15 + 1 frames back the low half places it ahead or on the last frame, at a
-        // full counter it was not sealed with.
+        // full counter it was not sealed with, and the search looks only ahead of the last.
         _ => logged.check_failed(),
     })
 }
@@ -371,15 +401,6 @@ fn replay(
     bus: &mut Bus,
     frames: &[Logged],
     expected: impl Fn(&Logged) -> Result<(), DecodeError>,
-) -> Tally {
-    replay_heard(bus, frames, expected, hears)
-}
-
-fn replay_heard(
-    bus: &mut Bus,
-    frames: &[Logged],
-    expected: impl Fn(&Logged) -> Result<(), DecodeError>,
-    hears: impl Fn(NodeId, Option<Epoch>, &Logged) -> bool,
 ) -> Tally {
     let mut all: Tally = [0; RejectCause::ALL.len()];
     for node in &mut bus.nodes {
@@ -445,9 +466,9 @@ fn replay_heard(
     all
 }
 
-/// After a replay the genuine traffic goes on: every node accepts every frame, all in
-/// sequence (no loss counted, no refusal).
-fn traffic_goes_on(bus: &mut Bus, ticks: std::ops::Range<u32>) {
+/// After a replay the genuine traffic goes on for `ticks` ticks: every node accepts every frame,
+/// all in sequence (no loss counted, no refusal).
+fn traffic_goes_on(bus: &mut Bus, ticks: u32) {
     let before: Vec<RejectCounters> = bus.nodes.iter().map(|n| *n.rx.counters()).collect();
     bus.run(ticks);
     for (node, before) in bus.nodes.iter().zip(before) {
@@ -490,24 +511,17 @@ fn the_whole_log_replayed_later_in_its_session_is_refused_but_for_the_latches() 
         assert!(tally[cause as usize] > 0, "{cause:?}: {tally:?}");
     }
     assert_eq!(tally[RejectCause::Session as usize], 0);
-    traffic_goes_on(&mut bus, TICKS..TICKS + 200);
+    traffic_goes_on(&mut bus, 200);
 }
 
 #[test]
 fn the_whole_log_replayed_in_a_new_session_is_refused_but_for_the_latches() {
     let recorded = recorded();
     let mut bus = recorded.next_session.clone();
-    // A receiver with no sequence on a CRC identifier looks for each frame in 256 high halves:
-    // for the 2^16 and more frames of an identifier that takes long in a debug build. Those
-    // are the node that joined last (no sequence on any identifier) and each node's own
-    // identifiers; the proptests below replay slices of the log to them.
-    bus.nodes.retain(|n| n.id != NodeId::LegDriveFr);
-    let tally = replay_heard(
-        &mut bus,
-        &recorded.log,
-        expected_next_session,
-        |node, _, logged| logged.from != node,
-    );
+    // Every node hears every frame of the old session: the one that joined last (no sequence
+    // on any identifier) and each node its own identifiers too, which it has no sequence on.
+    // A receiver with no sequence looks only in the halves of its session time, which is short.
+    let tally = replay(&mut bus, &recorded.log, expected_next_session);
     for cause in [
         RejectCause::Crc,
         RejectCause::Unauthentic,
@@ -517,7 +531,7 @@ fn the_whole_log_replayed_in_a_new_session_is_refused_but_for_the_latches() {
     }
     assert_eq!(tally[RejectCause::Repeated as usize], 0);
     assert_eq!(tally[RejectCause::WrongSequence as usize], 0);
-    traffic_goes_on(&mut bus, 300..500);
+    traffic_goes_on(&mut bus, 200);
 }
 
 /// A pick of frames from the log: `at` places it, `len` frames long.
@@ -556,14 +570,14 @@ proptest! {
     fn any_frame_replayed_later_in_its_session_is_refused(at in any::<prop::sample::Index>()) {
         let mut bus = recorded().later.clone();
         replay(&mut bus, slice(at, 1), expected_later);
-        traffic_goes_on(&mut bus, TICKS..TICKS + 5);
+        traffic_goes_on(&mut bus, 5);
     }
 
     #[test]
     fn any_frame_replayed_in_a_new_session_is_refused(at in any::<prop::sample::Index>()) {
         let mut bus = recorded().next_session.clone();
         replay(&mut bus, slice(at, 1), expected_next_session);
-        traffic_goes_on(&mut bus, 300..305);
+        traffic_goes_on(&mut bus, 5);
     }
 
     #[test]
@@ -582,10 +596,10 @@ proptest! {
         for pair in &pairs {
             let mut bus = recorded().later.clone();
             replay(&mut bus, pair, expected_later);
-            traffic_goes_on(&mut bus, TICKS..TICKS + 5);
+            traffic_goes_on(&mut bus, 5);
             let mut bus = recorded().next_session.clone();
             replay(&mut bus, pair, expected_next_session);
-            traffic_goes_on(&mut bus, 300..305);
+            traffic_goes_on(&mut bus, 5);
         }
     }
 }
@@ -601,10 +615,10 @@ proptest! {
         let frames = slice(at, len);
         let mut bus = recorded().later.clone();
         replay(&mut bus, frames, expected_later);
-        traffic_goes_on(&mut bus, TICKS..TICKS + 5);
+        traffic_goes_on(&mut bus, 5);
         let mut bus = recorded().next_session.clone();
         replay(&mut bus, frames, expected_next_session);
-        traffic_goes_on(&mut bus, 300..305);
+        traffic_goes_on(&mut bus, 5);
     }
 }
 
@@ -750,6 +764,7 @@ fn an_announcement_forged_without_the_key_opens_no_session() {
     let announce = AnyMessage::Announce(Announce {
         version: WireVersion::THIS,
         epoch: Epoch::new(u32::MAX),
+        time: SessionTime::from_ms(u32::MAX),
     });
     for mut rx in [Receiver::member(TEST_KEY), joined_member(OLD)] {
         let epoch = rx.session().epoch();
@@ -808,28 +823,33 @@ fn a_member_joins_on_the_announcement() {
         .unwrap();
     assert!(receive(&mut Receiver::member(TEST_KEY), &latch).is_ok());
 
-    let announce = announce_frame(WireVersion::THIS, OLD, 0);
+    let announce = announce_frame(WireVersion::THIS, OLD, 3);
     let accepted = receive(&mut member, &announce).unwrap();
     assert_eq!(accepted.status, E2eStatus::Initial);
     assert_eq!(
         accepted.message,
         AnyMessage::Announce(Announce {
             version: WireVersion::THIS,
-            epoch: OLD
+            epoch: OLD,
+            time: SessionTime::from_ms(300),
         })
     );
     assert_eq!(member.session().epoch(), Some(OLD));
+    assert_eq!(member.session().time(), SessionTime::from_ms(300));
     assert_eq!(*member.session().key(), TEST_KEY);
     assert_eq!(
         receive(&mut member, &wheel_command(0, OLD)).unwrap().status,
         E2eStatus::Initial
     );
-    // Its first bound frame starts its counter on that id at zero: the refused attempt above
-    // used none.
+    // Its first bound frame starts its counter on that id at the session time it joined at:
+    // the refused attempt above used none.
     let frame = tx.seal(member.session(), &command).unwrap();
-    assert_eq!(decode_frame(frame.id(), frame.data()).unwrap().counter, 0);
-    let mut owner = Receiver::owner(Session::owned(TEST_KEY, OLD));
-    assert!(receive(&mut owner, &frame).is_ok());
+    assert_eq!(decode_frame(frame.id(), frame.data()).unwrap().counter, 300);
+    let mut owner = owner_at(OLD, 320);
+    assert_eq!(
+        receive(&mut owner, &frame).unwrap().status,
+        E2eStatus::Initial
+    );
 }
 
 #[test]
@@ -842,15 +862,21 @@ fn a_greater_epoch_moves_the_member_and_restarts_every_counter() {
     let heartbeat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
         uptime: Millis::from_raw(1).unwrap(),
     });
-    for _ in 0..10 {
-        tx.seal(member.session(), &heartbeat).unwrap();
+    for expected in 0..10 {
+        let frame = tx.seal(member.session(), &heartbeat).unwrap();
+        assert_eq!(
+            decode_frame(frame.id(), frame.data()).unwrap().counter,
+            expected
+        );
     }
-    assert_eq!(tx.high_water(), 10);
 
-    let announce = announce_frame(WireVersion::THIS, NEW, 0);
+    // The restarted controller opens its session at time 0 and announces it; a member hears
+    // the announcement 200 ms in.
+    let announce = announce_frame(WireVersion::THIS, NEW, 2);
     assert!(receive(&mut member, &announce).is_ok());
     assert_eq!(member.session().epoch(), Some(NEW));
-    // The restarted controller counts from zero, and the member follows.
+    assert_eq!(member.session().time(), SessionTime::from_ms(200));
+    // The controller's counters started at its session time, 0, and the member follows.
     assert_eq!(
         receive(&mut member, &wheel_command(0, NEW)).unwrap().status,
         E2eStatus::Initial
@@ -867,10 +893,10 @@ fn a_greater_epoch_moves_the_member_and_restarts_every_counter() {
             "old-session counter {counter}"
         );
     }
-    // So does the member's own sender.
+    // The member's own sender starts again too, at the session time it is in.
     let frame = tx.seal(member.session(), &heartbeat).unwrap();
-    assert_eq!(decode_frame(frame.id(), frame.data()).unwrap().counter, 0);
-    let mut owner = Receiver::owner(Session::owned(TEST_KEY, NEW));
+    assert_eq!(decode_frame(frame.id(), frame.data()).unwrap().counter, 200);
+    let mut owner = owner_at(NEW, 230);
     assert_eq!(
         receive(&mut owner, &frame).unwrap().status,
         E2eStatus::Initial
@@ -946,6 +972,67 @@ fn an_announcement_of_the_same_epoch_replayed_is_refused() {
         receive(&mut member, &wheel_command(1, OLD)).unwrap().status,
         E2eStatus::Ok
     );
+    assert_eq!(member.session().time(), SessionTime::from_ms(4000));
+}
+
+/// In its epoch a member orders announcements by their session time, not their counter: it
+/// takes only a time after the last it heard, and its session time follows.
+#[test]
+fn a_member_takes_an_announcement_only_with_a_later_time() {
+    let at = |ms, counter| announce_frame_at(WireVersion::THIS, OLD, ms, counter);
+    let mut member = member_at(OLD, 5_000);
+    // The same time under another counter is a repeat; an earlier time is stale, whatever
+    // its counter.
+    assert_eq!(
+        receive(&mut member, &at(5_000, 77)),
+        Err(DecodeError::Repeated { id: 0x020 })
+    );
+    assert_eq!(
+        receive(&mut member, &at(4_999, 1_000)),
+        Err(DecodeError::WrongSequence { id: 0x020 })
+    );
+    assert_eq!(
+        receive(&mut member, &at(0, 0)),
+        Err(DecodeError::WrongSequence { id: 0x020 })
+    );
+    assert_eq!(member.session().time(), SessionTime::from_ms(5_000));
+    // A later time under a smaller counter moves it, however long after.
+    let accepted = receive(&mut member, &at(5_001, 0)).unwrap();
+    assert_eq!(accepted.status, E2eStatus::Initial);
+    assert_eq!(member.session().time(), SessionTime::from_ms(5_001));
+    assert!(receive(&mut member, &at(4_000_000_000, 3)).is_ok());
+    assert_eq!(member.session().time(), SessionTime::from_ms(4_000_000_000));
+    assert_eq!(member.counters().get(RejectCause::Repeated).raw(), 1);
+    assert_eq!(member.counters().get(RejectCause::WrongSequence).raw(), 2);
+    assert_eq!(member.counters().total(), 3);
+    // A greater epoch moves it to that session's time, even an earlier one.
+    assert!(receive(
+        &mut member,
+        &announce_frame_at(WireVersion::THIS, NEW, 10, 0)
+    )
+    .is_ok());
+    assert_eq!(member.session().epoch(), Some(NEW));
+    assert_eq!(member.session().time(), SessionTime::from_ms(10));
+}
+
+/// The controller hears its own announcements on the bus: in its epoch it takes them at any
+/// time (its clock is its own, not the announcements'), and moves nowhere.
+#[test]
+fn the_controller_takes_its_own_announcements_whatever_their_time() {
+    let mut owner = owner_at(OLD, 7_000);
+    for (ms, counter) in [(7_000, 70), (7_000, 70), (100, 1), (9_000_000, 2)] {
+        let frame = announce_frame_at(WireVersion::THIS, OLD, ms, counter);
+        assert!(receive(&mut owner, &frame).is_ok(), "{ms} ms");
+        assert_eq!(owner.session().time(), SessionTime::from_ms(7_000));
+        assert_eq!(owner.session().epoch(), Some(OLD));
+    }
+    assert_eq!(owner.counters().total(), 0);
+    // Its time is set by its clock alone; a member's is not.
+    owner.set_time(SessionTime::from_ms(8_000));
+    assert_eq!(owner.session().time(), SessionTime::from_ms(8_000));
+    let mut member = member_at(OLD, 7_000);
+    member.set_time(SessionTime::from_ms(8_000));
+    assert_eq!(member.session().time(), SessionTime::from_ms(7_000));
 }
 
 #[test]
@@ -1078,8 +1165,7 @@ proptest! {
 #[test]
 fn a_burst_of_5000_lost_frames_is_accepted_and_counted() {
     // Across the wrap of the low half: 63 000 → 68 001.
-    let mut member = Receiver::member(TEST_KEY);
-    receive(&mut member, &announce_frame(WireVersion::THIS, OLD, 0)).unwrap();
+    let mut member = member_at(OLD, 62_900);
     for counter in 62_990..=63_000 {
         receive(&mut member, &wheel_command(counter, OLD)).unwrap();
     }
@@ -1105,26 +1191,39 @@ fn a_burst_of_5000_lost_frames_is_accepted_and_counted() {
 }
 
 #[test]
-fn the_longest_burst_accepted_is_just_under_half_the_counter_range() {
-    let mut member = joined_member(OLD);
+fn the_longest_burst_in_sequence_is_just_under_half_the_counter_range() {
+    let mut member = member_at(OLD, 100);
     receive(&mut member, &wheel_command(100, OLD)).unwrap();
-    let frame = wheel_command(100 + 0x8000, OLD);
-    assert_eq!(
-        receive(&mut member, &frame),
-        Err(DecodeError::Unauthentic { id: 0x101 }),
-        "2^15 − 1 lost: the frame reads as behind"
-    );
     let frame = wheel_command(100 + 0x7FFF, OLD);
     assert_eq!(
         receive(&mut member, &frame).unwrap().status,
         E2eStatus::OkSomeLost { lost: 0x7FFE }
     );
     assert_eq!(member.counters().lost.raw(), 0x7FFE);
+    // 2^15 − 1 lost: the frame reads as behind, where its check fails; the search in the
+    // halves of the member's time finds it and the sequence starts again there. The loss is
+    // not counted: the receiver cannot tell how many halves it skipped.
+    let mut member = member_at(OLD, 100);
+    receive(&mut member, &wheel_command(100, OLD)).unwrap();
+    let frame = wheel_command(100 + 0x8000, OLD);
+    assert_eq!(
+        receive(&mut member, &frame).unwrap().status,
+        E2eStatus::Initial
+    );
+    assert_eq!(member.counters().lost.raw(), 0);
+    assert_eq!(member.counters().total(), 0);
+    assert_eq!(
+        receive(&mut member, &wheel_command(101 + 0x8000, OLD))
+            .unwrap()
+            .status,
+        E2eStatus::Ok
+    );
 }
 
 #[test]
 fn a_late_joiner_finds_a_crc_sender_past_the_first_wrap() {
-    // A CRC is tried at 256 high halves for the first frame of a sender.
+    // The status went out every millisecond since the session opened: its counter is about
+    // the session time, which the member learns from the announcement it joins on.
     let status = |counter: u32| {
         AnyMessage::Sync(Sync {
             tick: Tick::from_raw(counter).unwrap(),
@@ -1132,8 +1231,8 @@ fn a_late_joiner_finds_a_crc_sender_past_the_first_wrap() {
         .encode(&Session::owned(TEST_KEY, OLD), counter)
         .unwrap()
     };
-    let mut member = joined_member(OLD);
     let first = 200 << 16 | 0x1234;
+    let mut member = member_at(OLD, first - 40);
     assert_eq!(
         receive(&mut member, &status(first)).unwrap().status,
         E2eStatus::Initial
@@ -1148,10 +1247,10 @@ fn a_late_joiner_finds_a_crc_sender_past_the_first_wrap() {
 // The sender.
 
 #[test]
-fn the_sender_counts_per_identifier_and_resumes_where_told() {
-    let session = Session::owned(TEST_KEY, OLD);
+fn the_sender_counts_per_identifier_from_the_session_time() {
+    let session = Session::owned(TEST_KEY, OLD).at(SessionTime::from_ms(5_000));
     let mut tx = Sender::new();
-    let low = |frame: Frame| decode_frame(frame.id(), frame.data()).unwrap().counter;
+    let counter = |frame: Frame| decode_frame(frame.id(), frame.data()).unwrap().counter;
     let wheel = AnyMessage::WheelCommand(WheelCommand {
         torque: [Torque::default(); 2],
     });
@@ -1159,46 +1258,370 @@ fn the_sender_counts_per_identifier_and_resumes_where_told() {
         enable: DriveEnable::Disabled,
         position: [Angle::default(); 16].into(),
     });
-    assert_eq!(tx.high_water(), 0);
-    for expected in 0..3 {
-        assert_eq!(low(tx.seal(&session, &wheel).unwrap()), expected);
+    for expected in 5_000..5_003 {
+        assert_eq!(counter(tx.seal(&session, &wheel).unwrap()), expected);
     }
-    assert_eq!(low(tx.seal(&session, &legs).unwrap()), 0);
-    assert_eq!(tx.high_water(), 3);
+    // Every identifier started at the session time of the sender's first frame in the
+    // session; later frames count on from there, whatever the time.
+    let later = session.at(SessionTime::from_ms(9_000));
+    assert_eq!(counter(tx.seal(&later, &legs).unwrap()), 5_000);
+    assert_eq!(counter(tx.seal(&later, &wheel).unwrap()), 5_003);
+    // The E-stop counts with the session time: the greater of its next counter and the time.
+    let release = AnyMessage::EStop(EStop::release(NodeId::Teleop, ReleaseToken::new(1)));
+    let latch = AnyMessage::EStop(EStop::latch(NodeId::Teleop));
+    assert_eq!(counter(tx.seal(&later, &release).unwrap()), 9_000);
+    assert_eq!(counter(tx.seal(&later, &latch).unwrap()), 9_001);
+    assert_eq!(counter(tx.seal(&later, &release).unwrap()), 9_002);
+    let later = session.at(SessionTime::from_ms(20_000));
+    assert_eq!(counter(tx.seal(&later, &release).unwrap()), 20_000);
+    assert_eq!(counter(tx.seal(&later, &wheel).unwrap()), 5_004);
+    // Another session starts every counter again, at that session's time.
+    let next = Session::owned(TEST_KEY, NEW).at(SessionTime::from_ms(250));
+    assert_eq!(counter(tx.seal(&next, &wheel).unwrap()), 250);
+    assert_eq!(counter(tx.seal(&next, &legs).unwrap()), 250);
+    assert_eq!(counter(tx.seal(&next, &release).unwrap()), 250);
+}
 
-    // The teleop restarts within the session. The controller heard its heartbeats 0…9.
-    let heartbeat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
-        uptime: Millis::from_raw(1).unwrap(),
-    });
-    let mut teleop = Sender::new();
-    let mut controller = Receiver::owner(session);
-    for _ in 0..10 {
-        let frame = teleop.seal(&session, &heartbeat).unwrap();
-        receive(&mut controller, &frame).unwrap();
+/// A clock of the controller's session: the controller's receiver reads it, and every member
+/// hears it in the announcements, one every 100 ms.
+struct Clock {
+    ms: u32,
+    announced: u32,
+}
+
+impl Clock {
+    fn new(ms: u32) -> Clock {
+        Clock { ms, announced: 0 }
     }
-    let resume_at = teleop.high_water();
-    assert_eq!(resume_at, 10);
-    // Started afresh, its frames are behind the controller's sequence: refused.
-    let frame = Sender::new().seal(&session, &heartbeat).unwrap();
+
+    /// Runs the clock to `ms`: the controller reads it, and `members` hear the announcement
+    /// when one falls due.
+    fn to(&mut self, ms: u32, controller: &mut Receiver, members: &mut [&mut Receiver]) {
+        assert!(ms >= self.ms);
+        if ms / 100 > self.ms / 100 {
+            self.announce(ms / 100 * 100, members);
+        }
+        self.ms = ms;
+        controller.set_time(SessionTime::from_ms(ms));
+    }
+
+    fn announce(&mut self, ms: u32, members: &mut [&mut Receiver]) {
+        self.announced += 1;
+        let frame = announce_frame_at(WireVersion::THIS, OLD, ms, self.announced);
+        for member in members.iter_mut() {
+            receive(member, &frame).unwrap();
+            assert_eq!(member.session().time(), SessionTime::from_ms(ms));
+        }
+    }
+}
+
+fn heartbeat(ms: u32) -> AnyMessage {
+    AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
+        uptime: Millis::from_raw(ms).unwrap(),
+    })
+}
+
+/// Wire version 2 first refused a teleop restarted within the session until it resumed its
+/// counters from a state file. Now a node restarted within the session starts its counters at
+/// the session time it joins at, past everything it sent before: the controller and every
+/// member take it from its first frame, and the frames of its previous life stay refused.
+#[test]
+fn a_sender_restarted_within_the_session_is_taken_from_its_first_frame() {
+    for down_for in [30, 150_000] {
+        let mut clock = Clock::new(1_000);
+        let mut controller = owner_at(OLD, 1_000);
+        let mut drive = member_at(OLD, 1_000);
+        // First life: the teleop joins at 1 s and sends a heartbeat every 20 ms for 10 s.
+        let mut teleop = member_at(OLD, 1_000);
+        let mut tx = Sender::new();
+        let mut first_life = Vec::new();
+        for k in 0..500 {
+            let ms = 1_000 + 20 * k;
+            clock.to(ms, &mut controller, &mut [&mut drive, &mut teleop]);
+            let frame = tx.seal(teleop.session(), &heartbeat(ms)).unwrap();
+            for rx in [&mut controller, &mut drive] {
+                assert!(receive(rx, &frame).is_ok());
+            }
+            first_life.push(frame);
+        }
+        // The teleop restarts: a new receiver joins on the next announcement, a new sender.
+        let back = clock.ms + down_for;
+        clock.to(back, &mut controller, &mut [&mut drive]);
+        let mut teleop = Receiver::member(TEST_KEY);
+        clock.announce(back / 100 * 100 + 100, &mut [&mut drive, &mut teleop]);
+        let rejoined = teleop.session().time().ms();
+        clock.to(rejoined + 5, &mut controller, &mut []);
+        let mut tx = Sender::new();
+        let frame = tx.seal(teleop.session(), &heartbeat(rejoined)).unwrap();
+        assert_eq!(
+            decode_frame(frame.id(), frame.data()).unwrap().counter,
+            rejoined as u16,
+            "it starts at the session time it joined at"
+        );
+        for rx in [&mut controller, &mut drive] {
+            let status = receive(rx, &frame).unwrap().status;
+            let ahead = rejoined - 1_499;
+            if ahead < 0x8000 {
+                assert_eq!(status, E2eStatus::OkSomeLost { lost: ahead - 1 });
+            } else {
+                assert_eq!(status, E2eStatus::Initial);
+            }
+        }
+        // Its previous life, replayed now, is refused by both, in any order.
+        for frame in first_life.iter().rev().chain(&first_life) {
+            for rx in [&mut controller, &mut drive] {
+                let refused = receive(rx, frame).unwrap_err();
+                assert!(
+                    matches!(
+                        refused,
+                        DecodeError::WrongSequence { .. } | DecodeError::Unauthentic { .. }
+                    ),
+                    "{refused:?}"
+                );
+            }
+        }
+        // And its new life goes on in sequence.
+        let frame = tx.seal(teleop.session(), &heartbeat(rejoined)).unwrap();
+        for rx in [&mut controller, &mut drive] {
+            assert_eq!(receive(rx, &frame).unwrap().status, E2eStatus::Ok);
+        }
+    }
+}
+
+fn wheel_message(ms: u32) -> AnyMessage {
+    AnyMessage::WheelCommand(WheelCommand {
+        torque: [Torque::from_raw((ms % 1000) as i16).unwrap(); 2],
+    })
+}
+
+fn wheel_feedback(ms: u32) -> AnyMessage {
+    AnyMessage::WheelFeedback(WheelFeedback {
+        position: [WheelAngle::from_raw((ms % 1000) as i16).unwrap(); 2],
+        velocity: [WheelVelocity::default(); 2],
+        effort: [Torque::default(); 2],
+    })
+}
+
+/// Wire version 2 first looked for a sender's first CMAC frame at high half zero only, so a
+/// node that joined after the sender's counter passed 2^16 never accepted it. Now the senders
+/// count from the session time and the late joiner looks around its own.
+#[test]
+fn a_member_that_joins_after_the_counter_wrapped_takes_the_next_frame() {
+    // The controller's wheel command (CMAC) and the wheel drive's feedback (CRC), every
+    // millisecond since the session opened: 70 000 of each before the member joins.
+    let at = |ms| Session::owned(TEST_KEY, OLD).at(SessionTime::from_ms(ms));
+    let mut controller = Sender::new();
+    let mut wheel_drive = Sender::new();
+    let mut sent = Vec::new();
+    for ms in 0..70_002 {
+        let command = controller.seal(&at(ms), &wheel_message(ms)).unwrap();
+        let feedback = wheel_drive
+            .seal(&at(ms / 100 * 100), &wheel_feedback(ms))
+            .unwrap();
+        sent.push([command, feedback]);
+    }
     assert_eq!(
-        receive(&mut controller, &frame),
-        Err(DecodeError::WrongSequence { id: 0x201 })
+        decode_frame(0x101, sent[69_999][0].data()).unwrap().counter,
+        (69_999_u32 - 0x1_0000) as u16,
+        "the low counter wrapped"
     );
-    // Resumed from what it persisted, it is in sequence.
-    let mut resumed = Sender::resuming(&session, resume_at);
-    let frame = resumed.seal(&session, &heartbeat).unwrap();
-    assert_eq!(low(frame), 10);
+    let mut member = member_at(OLD, 70_000);
+    for (kind, id) in [(0, 0x101), (1, 0x300)] {
+        let frame = |ms: u32| &sent[ms as usize][kind];
+        assert_eq!(
+            receive(&mut member, frame(70_000)).unwrap().status,
+            E2eStatus::Initial,
+            "{id:#x}"
+        );
+        assert_eq!(
+            receive(&mut member, frame(70_001)).unwrap().status,
+            E2eStatus::Ok
+        );
+        // Replays of frames older than the last accepted are refused: within 2^15 as out of
+        // sequence, further back as failing their check (the search looks only ahead).
+        let check_failed = if kind == 0 {
+            DecodeError::Unauthentic { id }
+        } else {
+            DecodeError::CrcMismatch { id }
+        };
+        for (ms, refused) in [
+            (70_001, DecodeError::Repeated { id }),
+            (70_000, DecodeError::WrongSequence { id }),
+            (69_999, DecodeError::WrongSequence { id }),
+            (70_001 - 0x8000, DecodeError::WrongSequence { id }),
+            (70_001 - 0x8001, check_failed),
+            (70_001 - 0x1_0000, check_failed),
+            (70_002 - 0x1_0000, check_failed),
+            (0, check_failed),
+        ] {
+            assert_eq!(
+                receive(&mut member, frame(ms)),
+                Err(refused),
+                "{id:#x} {ms}"
+            );
+        }
+    }
+    assert_eq!(member.counters().total(), 16);
+    assert_eq!(member.counters().lost.raw(), 0);
+}
+
+/// Wire version 2 first could not place a frame 2^15 or more ahead of the last it accepted:
+/// after such a gap a receiver refused the sender for the rest of the session. Now the frame is
+/// found in the halves of the receiver's session time.
+#[test]
+fn a_gap_of_40_000_lost_frames_is_recovered() {
+    let mut clock = Clock::new(1_000);
+    let mut controller = owner_at(OLD, 1_000);
+    let mut drive = member_at(OLD, 1_000);
+    let mut teleop = member_at(OLD, 1_000);
+    let controller_session = *controller.session();
+    let mut controller_tx = Sender::new();
+    let mut drive_tx = Sender::new();
+    let mut teleop_tx = Sender::new();
+    let command = AnyMessage::TeleopCommand(TeleopCommand {
+        mode: TeleopMode::WheelForward,
+        body_height: BodyHeight::default(),
+        speed_scale: SpeedScale::from_raw(50).unwrap(),
+    });
+    // Each sender sends one frame a millisecond: the controller's wheel command (CMAC) to the
+    // drive, the drive's feedback (CRC) and the teleop's command (CMAC) to the controller. The
+    // frames of 41 000…80 999 ms are lost (the announcements get through).
+    let mut statuses = Vec::new();
+    for ms in 1_000..81_003 {
+        clock.to(ms, &mut controller, &mut [&mut drive, &mut teleop]);
+        let lost = (41_000..81_000).contains(&ms);
+        let frames = [
+            controller_tx.seal(
+                &controller_session.at(SessionTime::from_ms(ms)),
+                &wheel_message(ms),
+            ),
+            drive_tx.seal(drive.session(), &wheel_feedback(ms)),
+            teleop_tx.seal(teleop.session(), &command),
+        ];
+        let [wheel, feedback, command] = frames.map(Result::unwrap);
+        if lost {
+            continue;
+        }
+        let got = [
+            receive(&mut drive, &wheel),
+            receive(&mut controller, &feedback),
+            receive(&mut controller, &command),
+        ];
+        if ms >= 81_000 {
+            statuses.push(got.map(|got| got.unwrap().status));
+        } else {
+            assert!(got.iter().all(Result::is_ok), "{ms}: {got:?}");
+        }
+    }
     assert_eq!(
-        receive(&mut controller, &frame).unwrap().status,
-        E2eStatus::Ok
+        statuses,
+        [
+            [E2eStatus::Initial; 3],
+            [E2eStatus::Ok; 3],
+            [E2eStatus::Ok; 3],
+        ]
     );
-    assert_eq!(resumed.high_water(), 11);
-    // Resuming another session's counters is starting afresh.
-    let mut moved = Sender::resuming(&session, 500);
-    let frame = moved
-        .seal(&Session::owned(TEST_KEY, NEW), &heartbeat)
-        .unwrap();
-    assert_eq!(low(frame), 0);
+    assert_eq!(controller.counters().total(), 0);
+    assert_eq!(drive.counters().total(), 0);
+}
+
+/// A member that has just joined has no sequence to hold a frame against: it takes the first
+/// genuine frame it finds in the halves of its session time, and so takes a frame replayed from
+/// earlier in the session if its counter is in those halves. Further back it is refused: a
+/// CMAC frame recorded more than 2^16 · 2^8 ms (4.7 h) earlier, a CRC frame more than
+/// 2^16 · 2^12 ms (76 h) earlier.
+#[test]
+fn a_freshly_joined_member_refuses_a_replay_from_beyond_its_search() {
+    let sync = |counter: u32| {
+        AnyMessage::Sync(Sync {
+            tick: Tick::from_raw(counter).unwrap(),
+        })
+        .encode(&Session::owned(TEST_KEY, OLD), counter)
+        .unwrap()
+    };
+    let wheel = |counter: u32| wheel_command(counter, OLD);
+    type Seal = fn(u32) -> Frame;
+    let cases: [(Seal, u32, DecodeError); 2] = [
+        (wheel, 1 << 8, DecodeError::Unauthentic { id: 0x101 }),
+        (sync, 1 << 12, DecodeError::CrcMismatch { id: 0x010 }),
+    ];
+    for (seal, tries, check_failed) in cases {
+        // The member joins at `now`; the sender's counter then is about `now`.
+        let now = (tries + 44) << 16 | 0x1234;
+        // The lowest half it looks in is `tries − 1` below the one after its time's.
+        let lowest = (now >> 16) + 1 - (tries - 1);
+        for (recorded, taken) in [
+            (now - (tries << 16), false),
+            (now - (tries << 16) - 1, false),
+            (now - 0x4000_0000_u32.min(now), false),
+            ((lowest << 16) - 1, false),
+            (lowest << 16, true),
+            (now - ((tries - 2) << 16), true),
+            (now - 60_000, true),
+        ] {
+            let mut member = member_at(OLD, now);
+            let got = receive(&mut member, &seal(recorded));
+            if taken {
+                assert_eq!(got.unwrap().status, E2eStatus::Initial, "{recorded}");
+            } else {
+                assert_eq!(got, Err(check_failed), "{recorded}");
+            }
+            // Either way the genuine sender's next frame is taken, and the replay is then
+            // behind it.
+            let genuine = now + 10;
+            assert!(receive(&mut member, &seal(genuine))
+                .unwrap()
+                .status
+                .is_accepted());
+            assert!(receive(&mut member, &seal(recorded)).is_err());
+        }
+        assert!(now - (lowest << 16) < tries << 16);
+    }
+}
+
+/// Wire version 2 first counted E-stop releases like any identifier, from zero per sender, so
+/// that two operators releasing on the one E-stop identifier (the teleop and a tool) collided
+/// and the second was refused as a repeat. Now a release counts with the session time.
+#[test]
+fn two_operators_releasing_in_turn_are_both_taken() {
+    let mut clock = Clock::new(1_000);
+    let mut controller = owner_at(OLD, 1_000);
+    let mut teleop = member_at(OLD, 1_000);
+    let mut tool = member_at(OLD, 1_000);
+    let mut teleop_tx = Sender::new();
+    let mut tool_tx = Sender::new();
+    let release = |source| AnyMessage::EStop(EStop::release(source, ReleaseToken::new(3)));
+    let latch = |source| AnyMessage::EStop(EStop::latch(source));
+    let mut statuses = Vec::new();
+    // Times away from a 2^16 ms boundary of the session time (see the report on them).
+    for (ms, source) in [
+        (10_020, NodeId::Teleop),
+        (12_040, NodeId::Tool),
+        (12_150, NodeId::Teleop),
+        (30_010, NodeId::Teleop),
+        (31_000, NodeId::Tool),
+        (100_000, NodeId::Tool),
+        (100_130, NodeId::Teleop),
+        (190_500, NodeId::Teleop),
+        (190_610, NodeId::Tool),
+    ] {
+        clock.to(ms, &mut controller, &mut [&mut teleop, &mut tool]);
+        let (tx, rx) = match source {
+            NodeId::Teleop => (&mut teleop_tx, &teleop),
+            _ => (&mut tool_tx, &tool),
+        };
+        // Each operator latches first, then releases.
+        let frame = tx.seal(rx.session(), &latch(source)).unwrap();
+        assert!(receive(&mut controller, &frame).is_ok());
+        let frame = tx.seal(rx.session(), &release(source)).unwrap();
+        let accepted = receive(&mut controller, &frame)
+            .unwrap_or_else(|e| panic!("{source:?} at {ms} ms: {e:?}"));
+        assert_eq!(accepted.message, release(source));
+        statuses.push(accepted.status);
+    }
+    assert_eq!(statuses[0], E2eStatus::Initial);
+    assert!(statuses.iter().all(|s| s.is_accepted()));
+    assert_eq!(controller.counters().total(), 0);
 }
 
 // ------------------------------------------------------------------------------------------

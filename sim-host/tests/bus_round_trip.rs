@@ -9,6 +9,7 @@ use std::time::Duration;
 
 use host_can::bus::Bus;
 use host_can::inproc_bus::{InprocBus, InprocEndpoint};
+use protocol::SessionTime;
 use protocol::{
     Angle, Announce, AnyMessage, Drive, DriveEnable, DriveFlags, DriveStatus, EStop, Epoch, Frame,
     Joints, Leg, LegFeedback, LegTargets, NodeId, PerDrive, Receiver, ReleaseToken, Sender,
@@ -85,6 +86,7 @@ impl TestController {
             let announce = self.seal(AnyMessage::Announce(Announce {
                 version: WireVersion::THIS,
                 epoch: Epoch::new(1),
+                time: SessionTime::from_ms(self.services * 1000 / u32::from(HZ)),
             }));
             self.bus.send(&announce).unwrap();
         }

@@ -1,6 +1,7 @@
 //! The emulated drives enforce their own ratings whatever the wire says: an authentic command
 //! beyond them is clamped, applied within them, and counted.
 
+use protocol::SessionTime;
 use protocol::{
     Angle, Announce, AnyMessage, DriveEnable, Epoch, Frame, Joints, Leg, LegTargets, Session,
     Torque, WheelCommand, WireVersion, TEST_KEY,
@@ -15,6 +16,7 @@ fn announce() -> Frame {
     AnyMessage::Announce(Announce {
         version: WireVersion::THIS,
         epoch: Epoch::new(1),
+        time: SessionTime::from_ms(0),
     })
     .encode(&SESSION, 0)
     .unwrap()

@@ -8,6 +8,7 @@ use protocol::{EncodeError, Frame, MessageId};
 use teleop_core::bus_status::BusStatus;
 use teleop_core::keys::{action, Action, Key};
 use teleop_core::operator::{Operator, Outcome};
+use teleop_core::release::ReleaseOutcome;
 
 /// Lines kept in the event log.
 const LOG_LINES: usize = 4;
@@ -64,15 +65,14 @@ impl App {
             ));
             return;
         };
-        let was_latched = self.operator.estop_latched();
         if self.operator.press(now_ms, act) == Outcome::Quit {
             self.quit = true;
             return;
         }
         match act {
             Action::EStop => self.note("E-STOP latched: press R twice to release".into()),
-            Action::Release if was_latched && !self.operator.estop_latched() => {
-                self.note("E-stop released: the robot waits for a new command".into())
+            Action::Release if self.operator.release().pending() => {
+                self.note("releasing the E-stop: waiting for the controller to confirm".into())
             }
             Action::Release if self.operator.release_armed(now_ms) => {
                 self.note("press R again within 2 s to release the E-stop".into())
@@ -85,6 +85,9 @@ impl App {
     /// The frames due at `now_ms` (send them on the bus).
     pub fn poll(&mut self, now_ms: u64) -> Result<Vec<Frame>, EncodeError> {
         let frames = self.operator.poll(now_ms)?;
+        if let Some(outcome) = self.operator.take_release_outcome() {
+            self.note(release_note(outcome).into());
+        }
         if frames
             .iter()
             .any(|f| f.id() == MessageId::TeleopHeartbeat.raw())
@@ -187,5 +190,21 @@ fn describe(key: Key) -> String {
         Key::Up => "↑".into(),
         Key::Down => "↓".into(),
         Key::Esc => "Esc".into(),
+    }
+}
+
+/// What the operator is told when a release ends.
+fn release_note(outcome: ReleaseOutcome) -> &'static str {
+    match outcome {
+        ReleaseOutcome::Released => "E-stop released: the robot waits for a new command (X first)",
+        ReleaseOutcome::Superseded => {
+            "the release was not taken: the E-stop latched again; press R twice to release it"
+        }
+        ReleaseOutcome::TimedOut => {
+            "the controller kept its E-stop for 1 s: press R twice to try again"
+        }
+        ReleaseOutcome::NothingToRelease => {
+            "no E-stop to release: the controller does not report one"
+        }
     }
 }

@@ -168,7 +168,16 @@ fn in_real_time_the_key_reaches_the_actuators_within_about_a_period() {
         })
         .unwrap_or_else(|| panic!("E-stop {n}: the legs were never disabled"));
         latencies_ms.push((seen - pressed).as_secs_f64() * 1e3);
-        // Release (R R) and wait until the legs are enabled again.
+        // Once the controller reports its E-stop (a release answers the latch it reports),
+        // release (R R) and wait until the legs are enabled again.
+        let reported = wait_for(
+            &mut bus,
+            &mut app,
+            start,
+            Duration::from_secs(1),
+            |f| matches!(decode_frame(f.id(), f.data()).map(|d| d.message), Ok(AnyMessage::ControllerStatus(s)) if s.mode == ControllerMode::EStop),
+        );
+        assert!(reported.is_some(), "E-stop {n}: never reported");
         for _ in 0..2 {
             app.key(start.elapsed().as_millis() as u64, Key::Char('r'));
         }

@@ -4,7 +4,7 @@ use protocol::{
     Angle, Announce, AnyMessage, BodyHeight, ControllerMode, ControllerStatus, Count, Drive,
     DriveFlags, DriveStatus, EStop, EStopAction, Epoch, FaultFlags, Frame, MessageId, Receiver,
     RejectCause, RejectCounters, ReleaseToken, Sender, Session, TeleopCommand, TeleopMode, Tick,
-    Torque, WheelAngle, WheelFeedback, WheelVelocity, WireVersion, TEST_KEY,
+    Torque, WheelFeedback, WheelVelocity, WireVersion, TEST_KEY,
 };
 use ratatui::backend::TestBackend;
 use ratatui::Terminal;
@@ -52,6 +52,7 @@ impl Robot {
         self.seal(AnyMessage::Announce(Announce {
             version: WireVersion::THIS,
             epoch: Epoch::new(1),
+            time: self.session.time(),
         }))
     }
 
@@ -70,7 +71,6 @@ impl Robot {
 
     fn wheels(&mut self, left: f32, right: f32) -> Frame {
         self.seal(AnyMessage::WheelFeedback(WheelFeedback {
-            position: [WheelAngle::saturating_from_si(0.0); 2],
             velocity: [
                 WheelVelocity::saturating_from_si(left),
                 WheelVelocity::saturating_from_si(right),

@@ -24,7 +24,7 @@ use protocol::busload::SCHEDULE;
 use protocol::{
     Angle, Announce, AnyMessage, BodyHeight, ControllerStatus, DecodeError, DriveEnable, EStop,
     EStopAction, Frame, LegTargets, MessageId, NodeId, Receiver, RejectCounters, ReleaseToken,
-    Sender, Session, Torque, WheelCommand, WireVersion,
+    Sender, Session, SessionTime, Torque, WheelCommand, WireVersion,
 };
 
 use crate::config::Config;
@@ -59,6 +59,7 @@ pub struct Node {
     sender: Sender,
     release_token: ReleaseToken,
     announced: bool,
+    started: Option<Tick>,
     encode_failures: u32,
 }
 
@@ -81,6 +82,7 @@ impl Node {
             sender: Sender::new(),
             release_token: ReleaseToken::new(0),
             announced: false,
+            started: None,
             encode_failures: 0,
         })
     }
@@ -140,6 +142,7 @@ impl Node {
     /// so their flood adds at most 2 frames per tick: at 20 % loss the measure still reads about
     /// 15 % at 250 Hz and 12 % at 1 kHz.
     pub fn on_frame(&mut self, now: Tick, raw_id: u16, data: &[u8]) -> Result<(), DecodeError> {
+        self.advance(now);
         let accepted = self.receiver.receive(raw_id, data)?;
         if matches!(accepted.message, AnyMessage::TeleopCommand(_)) && !self.teleop_budget.take() {
             return Err(self.refuse(DecodeError::RateLimited { id: raw_id }));
@@ -161,6 +164,18 @@ impl Node {
         Ok(())
     }
 
+    /// The session time is the time since this node's first call: what every sender's
+    /// counters start at.
+    fn advance(&mut self, now: Tick) {
+        let started = *self.started.get_or_insert(now);
+        let ms = self
+            .controller
+            .config()
+            .rate
+            .ms_from_ticks(now.since(started));
+        self.receiver.set_time(SessionTime::from_ms(ms));
+    }
+
     fn refuse(&mut self, error: DecodeError) -> DecodeError {
         self.receiver.refuse(error);
         error
@@ -179,6 +194,7 @@ impl Node {
     /// until the next call get a fresh operator-command budget, and the link monitor's verdict
     /// reaches the controller before its step.
     pub fn poll(&mut self, now: Tick) -> (Output, TickFrames) {
+        self.advance(now);
         self.teleop_budget.refill();
         let degraded = self.link.update(now);
         self.controller.set_link_degraded(degraded);
@@ -270,6 +286,7 @@ impl Node {
                 .session()
                 .epoch()
                 .unwrap_or(protocol::Epoch::new(0)),
+            time: self.receiver.session().time(),
         })
     }
 

@@ -7,8 +7,8 @@ use firmware::config::Config;
 use firmware::Node;
 use protocol::{
     Acceleration, Angle, AngularRate, AnyMessage, BodyHeight, Epoch, Frame, Imu, JointVelocity,
-    Joints, LegFeedback, QuatComponent, Sender, Session, SpeedScale, TeleopCommand, TeleopMode,
-    Torque, WheelAngle, WheelFeedback, WheelVelocity, TEST_KEY,
+    Joints, LegFeedback, Sender, Session, SpeedScale, TeleopCommand, TeleopMode, Torque,
+    WheelFeedback, WheelVelocity, TEST_KEY,
 };
 
 /// The session the node under test opens (the simulation's key, epoch 1); the test's other
@@ -72,7 +72,6 @@ pub fn leg_feedback(positions_rad: &[f32]) -> LegFeedback {
 /// The wheel drive's feedback with both wheels at rest.
 pub fn wheels_at_rest() -> AnyMessage {
     AnyMessage::WheelFeedback(WheelFeedback {
-        position: [WheelAngle::saturating_from_si(0.0); 2],
         velocity: [WheelVelocity::saturating_from_si(0.0); 2],
         effort: [Torque::saturating_from_si(0.0); 2],
     })
@@ -82,7 +81,7 @@ pub fn wheels_at_rest() -> AnyMessage {
 pub fn imu(pitch_rad: f32) -> Imu {
     let half = 0.5 * pitch_rad;
     Imu {
-        orientation: [half.cos(), 0.0, half.sin(), 0.0].map(QuatComponent::saturating_from_si),
+        orientation: Imu::orientation_of([half.cos(), 0.0, half.sin(), 0.0]),
         angular_rate: [AngularRate::saturating_from_si(0.0); 3],
         acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
     }

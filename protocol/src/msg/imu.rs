@@ -9,9 +9,13 @@ use crate::units::{Acceleration, AngularRate, QuatComponent};
 ///
 /// | byte  | field          | type    | meaning                                            |
 /// |-------|----------------|---------|----------------------------------------------------|
-/// | 6–13  | `orientation`  | 4 × i16 | quaternion w, x, y, z (world ← body); 1e-4, ±1      |
-/// | 14–19 | `angular_rate` | 3 × i16 | gyro x, y, z; 1e-3 rad/s                            |
-/// | 20–25 | `acceleration` | 3 × i16 | accelerometer x, y, z (specific force); 1e-2 m/s²   |
+/// | 6–11  | `orientation`  | 3 × i16 | quaternion x, y, z (world ← body); 1e-4, ±1         |
+/// | 12–17 | `angular_rate` | 3 × i16 | gyro x, y, z; 1e-3 rad/s                            |
+/// | 18–23 | `acceleration` | 3 × i16 | accelerometer x, y, z (specific force); 1e-2 m/s²   |
+///
+/// The quaternion's w is not sent: the IMU sends the sign of the unit quaternion with w ≥ 0
+/// (both signs are the same rotation), so w = √(1 − x² − y² − z²) ([`Imu::quaternion`]). The
+/// 24-byte frame keeps the 1 kHz schedule's busiest cycle within half the bus.
 #[derive(
     Debug,
     Clone,
@@ -23,8 +27,8 @@ use crate::units::{Acceleration, AngularRate, QuatComponent};
     postcard::experimental::max_size::MaxSize,
 )]
 pub struct Imu {
-    /// Orientation quaternion w, x, y, z.
-    pub orientation: [QuatComponent; 4],
+    /// Orientation quaternion x, y, z (w ≥ 0 implied).
+    pub orientation: [QuatComponent; 3],
     /// Angular rate about x, y, z.
     pub angular_rate: [AngularRate; 3],
     /// Specific force along x, y, z.
@@ -36,7 +40,7 @@ impl Message for Imu {
     const NAME: &'static str = "Imu";
     const DOC: &'static str = "Torso orientation, angular rate and acceleration";
     const FIELDS: &'static [Field] = &[
-        array::<QuatComponent>("orientation", &["w", "x", "y", "z"]),
+        array::<QuatComponent>("orientation", &["x", "y", "z"]),
         array::<AngularRate>("angular_rate", &["x", "y", "z"]),
         array::<Acceleration>("acceleration", &["x", "y", "z"]),
     ];
@@ -45,3 +49,22 @@ impl Message for Imu {
     }
 }
 check_layout!(Imu);
+
+impl Imu {
+    /// The unit quaternion w, x, y, z of a full orientation `[w, x, y, z]` (either sign), as
+    /// sent: the sign with w ≥ 0, w dropped.
+    pub fn orientation_of(q: [f32; 4]) -> [QuatComponent; 3] {
+        let [w, x, y, z] = q;
+        let sign = if w < 0.0 { -1.0 } else { 1.0 };
+        [x, y, z].map(|c| QuatComponent::saturating_from_si(sign * c))
+    }
+
+    /// The orientation as a quaternion w, x, y, z, with w ≥ 0 recovered from x, y, z (0 when
+    /// wire rounding puts x² + y² + z² above 1).
+    pub fn quaternion(&self) -> [f32; 4] {
+        let [x, y, z] = self.orientation.map(|c| c.si());
+        let w_sq = 1.0 - (x * x + y * y + z * z);
+        let w = if w_sq > 0.0 { libm::sqrtf(w_sq) } else { 0.0 };
+        [w, x, y, z]
+    }
+}

@@ -4,15 +4,17 @@ use crate::codec::{check_layout, Message};
 use crate::id::MessageId;
 use crate::node::WHEEL_NAMES;
 use crate::signal::{array, Field};
-use crate::units::{Torque, WheelAngle, WheelVelocity};
+use crate::units::{Torque, WheelVelocity};
 
 /// Feedback of both wheels, id `0x184`, wheel drive → controller.
 ///
 /// | byte  | field      | type    | meaning                                      |
 /// |-------|------------|---------|----------------------------------------------|
-/// | 6–9   | `position` | 2 × i16 | left, right; wrapped to ±π, 1e-4 rad         |
-/// | 10–13  | `velocity` | 2 × i16 | left, right; 1e-2 rad/s, + = forward         |
-/// | 14–17 | `effort`   | 2 × i16 | left, right; applied torque, 1e-2 N·m        |
+/// | 6–9   | `velocity` | 2 × i16 | left, right; 1e-2 rad/s, + = forward         |
+/// | 10–13 | `effort`   | 2 × i16 | left, right; applied torque, 1e-2 N·m        |
+///
+/// No wheel angle: the controller balances and drives on speed, and the 16-byte frame keeps the
+/// 1 kHz schedule's busiest cycle within half the bus (`cargo xtask busload`).
 #[derive(
     Debug,
     Clone,
@@ -24,8 +26,6 @@ use crate::units::{Torque, WheelAngle, WheelVelocity};
     postcard::experimental::max_size::MaxSize,
 )]
 pub struct WheelFeedback {
-    /// Wheel angles, wrapped.
-    pub position: [WheelAngle; 2],
     /// Wheel speeds.
     pub velocity: [WheelVelocity; 2],
     /// Wheel torques.
@@ -35,9 +35,8 @@ pub struct WheelFeedback {
 impl Message for WheelFeedback {
     type Address = ();
     const NAME: &'static str = "WheelFeedback";
-    const DOC: &'static str = "Angle, speed and torque of both wheels";
+    const DOC: &'static str = "Speed and torque of both wheels";
     const FIELDS: &'static [Field] = &[
-        array::<WheelAngle>("position", &WHEEL_NAMES),
         array::<WheelVelocity>("velocity", &WHEEL_NAMES),
         array::<Torque>("effort", &WHEEL_NAMES),
     ];

@@ -43,8 +43,13 @@ pub fn any_message() -> impl Strategy<Value = AnyMessage> {
             })
         ),
         tick().prop_map(|tick| AnyMessage::Sync(Sync { tick })),
-        (version(), epoch())
-            .prop_map(|(version, epoch)| AnyMessage::Announce(Announce { version, epoch })),
+        (version(), epoch(), any::<u32>()).prop_map(|(version, epoch, ms)| {
+            AnyMessage::Announce(Announce {
+                version,
+                epoch,
+                time: SessionTime::from_ms(ms),
+            })
+        }),
         (pick(DriveEnable::ALL), proptest::array::uniform16(angle())).prop_map(
             |(enable, position)| AnyMessage::LegTargets(LegTargets {
                 enable,
@@ -147,19 +152,44 @@ pub fn controller_session() -> Session {
     Session::owned(TEST_KEY, EPOCH)
 }
 
-/// The controller's announcement of `epoch` in version `version`, sealed with announcement
-/// counter `counter`.
+/// The controller's announcement of `epoch` in version `version` at session time `counter`
+/// × 100 ms, sealed with announcement counter `counter`.
 pub fn announce_frame(version: WireVersion, epoch: Epoch, counter: u32) -> Frame {
-    AnyMessage::Announce(Announce { version, epoch })
-        .encode(&Session::owned(TEST_KEY, epoch), counter)
-        .unwrap()
+    announce_frame_at(version, epoch, counter.saturating_mul(100), counter)
 }
 
-/// A member receiver that heard the announcement of `epoch` (counter 0) and joined.
+/// The controller's announcement of `epoch` in version `version` at session time `ms`, sealed
+/// with announcement counter `counter`.
+pub fn announce_frame_at(version: WireVersion, epoch: Epoch, ms: u32, counter: u32) -> Frame {
+    let time = SessionTime::from_ms(ms);
+    AnyMessage::Announce(Announce {
+        version,
+        epoch,
+        time,
+    })
+    .encode(&Session::owned(TEST_KEY, epoch).at(time), counter)
+    .unwrap()
+}
+
+/// A member receiver that heard the announcement of `epoch` (counter 0, session time 0) and
+/// joined.
 pub fn joined_member(epoch: Epoch) -> Receiver {
+    member_at(epoch, 0)
+}
+
+/// A member receiver that joined on the announcement of `epoch` at session time `ms`.
+pub fn member_at(epoch: Epoch, ms: u32) -> Receiver {
     let mut member = Receiver::member(TEST_KEY);
-    let frame = announce_frame(WireVersion::THIS, epoch, 0);
+    let frame = announce_frame_at(WireVersion::THIS, epoch, ms, ms / 100);
     member.receive(frame.id(), frame.data()).unwrap();
     assert_eq!(member.session().epoch(), Some(epoch));
+    assert_eq!(member.session().time(), SessionTime::from_ms(ms));
     member
+}
+
+/// The controller's receiver at session time `ms`.
+pub fn owner_at(epoch: Epoch, ms: u32) -> Receiver {
+    let mut owner = Receiver::owner(Session::owned(TEST_KEY, epoch));
+    owner.set_time(SessionTime::from_ms(ms));
+    owner
 }

@@ -27,7 +27,7 @@ pub struct LockstepOptions {
     pub max_speed: Option<f64>,
 }
 
-/// Runs `options.cycles` cycles. `peers(cycle)` runs after the simulator has sent its frames
+/// Runs `options.cycles` cycles after joining the controller's session. `peers(cycle)` runs after the simulator has sent its frames
 /// and before it waits: nodes sharing this thread (the in-process controller, a scripted
 /// teleop) do their work there; over SocketCAN it is a no-op. `observe` sees the simulator after
 /// each cycle (progress, stop conditions); returning `false` ends the run early.
@@ -41,7 +41,10 @@ pub fn run(
 ) -> Result<RunStats, RunError> {
     let started = Instant::now();
     let mut stats = RunStats::default();
-    for _ in 0..options.cycles {
+    // Cycles spent waiting to join count against the same budget, so a run without a
+    // controller ends (with no cycles run) after as many reply timeouts.
+    let mut joining = 0_u64;
+    while stats.cycles < options.cycles && joining < options.cycles {
         let advanced = cycle(
             sim,
             bus,
@@ -51,6 +54,7 @@ pub fn run(
             &mut peers,
         )?;
         if !advanced {
+            joining += 1;
             continue;
         }
         recorder.row(sim.telemetry())?;
@@ -113,6 +117,9 @@ pub fn cycle(
         }
     }
     if !joined {
+        // No SYNC goes out before the join, so end the cycle here: a bus that delays frames
+        // by cycles must still deliver the announcement.
+        bus.end_cycle()?;
         return Ok(false);
     }
     if !commanded {

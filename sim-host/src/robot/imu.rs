@@ -5,9 +5,7 @@ use rand::rngs::SmallRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
-use protocol::{
-    Acceleration, AngularRate, AnyMessage, EncodeError, Frame, Imu, Key, MessageId, QuatComponent,
-};
+use protocol::{Acceleration, AngularRate, AnyMessage, EncodeError, Frame, Imu, Key, MessageId};
 
 use crate::robot::link::NodeLink;
 
@@ -87,7 +85,7 @@ impl ImuNode {
             *value += bias + self.gaussian(n.accel_std_m_s2);
         }
         AnyMessage::Imu(Imu {
-            orientation: quat.map(|c| QuatComponent::saturating_from_si(c as f32)),
+            orientation: Imu::orientation_of(quat.map(|c| c as f32)),
             angular_rate: rate.map(|r| AngularRate::saturating_from_si(r as f32)),
             acceleration: force.map(|a| Acceleration::saturating_from_si(a as f32)),
         })

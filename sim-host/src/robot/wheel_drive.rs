@@ -4,7 +4,7 @@
 //! Like a real drive it enforces its rating whatever the wire says: a torque above
 //! [`WHEEL_PEAK_TORQUE_NM`] is clamped to it and the command counted ([`WheelDrive::clamped`]).
 
-use protocol::{AnyMessage, Frame, MessageId, Torque, WheelAngle, WheelFeedback, WheelVelocity};
+use protocol::{AnyMessage, Frame, MessageId, Torque, WheelFeedback, WheelVelocity};
 
 use crate::robot::drive_core::{Authority, DriveCore};
 use crate::robot::physics::Physics;
@@ -75,13 +75,7 @@ impl WheelDrive {
 
     /// The feedback frame for the current state.
     pub fn feedback(&mut self, physics: &Physics) -> AnyMessage {
-        let wrap = |a: f64| {
-            (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI
-        };
         AnyMessage::WheelFeedback(WheelFeedback {
-            position: physics
-                .wheel_positions_rad()
-                .map(|a| WheelAngle::saturating_from_si(wrap(a) as f32)),
             velocity: physics
                 .wheel_velocities_rad_s()
                 .map(|v| WheelVelocity::saturating_from_si(v as f32)),

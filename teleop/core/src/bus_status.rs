@@ -116,7 +116,7 @@ mod tests {
     use super::*;
     use protocol::{
         Angle, BodyHeight, ControllerMode, Epoch, FaultFlags, ReleaseToken, Session, Tick, Torque,
-        WheelAngle, WheelFeedback, WheelVelocity, TEST_KEY,
+        WheelFeedback, WheelVelocity, TEST_KEY,
     };
 
     const SESSION: Session = Session::owned(TEST_KEY, Epoch::new(1));
@@ -137,7 +137,6 @@ mod tests {
 
     fn wheels(speed: f32) -> Frame {
         AnyMessage::WheelFeedback(WheelFeedback {
-            position: [WheelAngle::saturating_from_si(0.0); 2],
             velocity: [WheelVelocity::saturating_from_si(speed); 2],
             effort: [Torque::saturating_from_si(0.0); 2],
         })

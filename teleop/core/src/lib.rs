@@ -17,5 +17,6 @@ pub mod bus_status;
 pub mod keys;
 pub mod link;
 pub mod operator;
+pub mod release;
 pub mod scenario;
 pub mod scripted;

@@ -1,14 +1,9 @@
-//! The operator's end of the bus session: it joins the session the controller announces, seals
-//! its commands in it (authenticated with the key), and resumes its counters after a restart
-//! from what it persisted, so that its first frames are fresh to a controller that kept
-//! running.
+//! The operator's end of the bus session: it joins the session the controller announces and
+//! seals its commands in it (authenticated with the key). A restarted teleop needs no state:
+//! its counters start at the session time it rejoins at, above everything it sent before (see
+//! [`protocol::session`]).
 
-use protocol::{AnyMessage, EncodeError, Epoch, Frame, Key, MessageId, Receiver, Sender, Session};
-
-/// How far ahead of the counters in use a teleop persists its resume point: it rewrites its
-/// state file once per this many frames on its busiest identifier, and after a restart resumes
-/// past every counter it can have used.
-pub const RESUME_RESERVE: u32 = 4_096;
+use protocol::{AnyMessage, EncodeError, Epoch, Frame, Key, MessageId, Receiver, Sender};
 
 /// The operator's session state: a member receiver for the controller's announcement and
 /// status, and the sender of its own frames.
@@ -16,7 +11,6 @@ pub const RESUME_RESERVE: u32 = 4_096;
 pub struct OperatorLink {
     receiver: Receiver,
     sender: Sender,
-    resume: Option<(Epoch, u32)>,
 }
 
 impl OperatorLink {
@@ -25,16 +19,6 @@ impl OperatorLink {
         Self {
             receiver: Receiver::member(key),
             sender: Sender::new(),
-            resume: None,
-        }
-    }
-
-    /// A link that, on joining session `epoch`, starts every counter at `counter` (a resume
-    /// point this teleop persisted in that session).
-    pub fn resuming(key: Key, epoch: Epoch, counter: u32) -> Self {
-        Self {
-            resume: Some((epoch, counter)),
-            ..Self::new(key)
         }
     }
 
@@ -45,14 +29,7 @@ impl OperatorLink {
         if id != MessageId::Announce.raw() && id != MessageId::ControllerStatus.raw() {
             return None;
         }
-        let before = self.receiver.session().epoch();
         let accepted = self.receiver.receive(id, frame.data()).ok()?;
-        let now = self.receiver.session().epoch();
-        if now != before {
-            if let Some((epoch, counter)) = self.resume.filter(|(epoch, _)| Some(*epoch) == now) {
-                self.sender = Sender::resuming(&Session::owned(*self.key(), epoch), counter);
-            }
-        }
         Some(accepted.message)
     }
 
@@ -74,11 +51,5 @@ impl OperatorLink {
     /// The key.
     pub fn key(&self) -> &Key {
         self.receiver.session().key()
-    }
-
-    /// What to persist so that a restarted teleop resumes fresh: the session and a counter
-    /// past every one used so far.
-    pub fn resume_point(&self) -> Option<(Epoch, u32)> {
-        Some((self.epoch()?, self.sender.high_water()))
     }
 }

@@ -7,11 +7,12 @@
 
 use protocol::{
     AnyMessage, BodyHeight, ControllerMode, EStop, EStopAction, EncodeError, Frame, Millis, NodeId,
-    ReleaseToken, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, TEST_KEY,
+    SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, TEST_KEY,
 };
 
 use crate::keys::Action;
 use crate::link::OperatorLink;
+use crate::release::{Release, ReleaseOutcome};
 
 /// Period of the command and heartbeat, ms (50 Hz).
 pub const PERIOD_MS: u64 = 20;
@@ -48,8 +49,7 @@ pub struct Operator {
     command_changed: bool,
     next_send_ms: u64,
     link: OperatorLink,
-    /// The release token of the controller's last authentic status.
-    release_token: Option<ReleaseToken>,
+    release: Release,
 }
 
 impl Default for Operator {
@@ -78,7 +78,7 @@ impl Operator {
             command_changed: true,
             next_send_ms: 0,
             link,
-            release_token: None,
+            release: Release::default(),
         }
     }
 
@@ -88,13 +88,23 @@ impl Operator {
     }
 
     /// Takes a frame heard on the bus: the controller's announcement joins its session; an
-    /// authentic status heard now confirms a latch this operator sent and gives the token a
-    /// release must echo.
+    /// authentic status heard now confirms a latch this operator sent, gives the token a
+    /// release must echo, and ends a release on its way.
     pub fn observe(&mut self, frame: &Frame) {
         if let Some(AnyMessage::ControllerStatus(status)) = self.link.observe(frame) {
-            self.release_token = Some(status.release_token);
+            self.release.observe(&status);
             self.observe_controller(status.mode);
         }
+    }
+
+    /// The E-stop release: whether one is on its way, and how the last one ended.
+    pub fn release(&self) -> &Release {
+        &self.release
+    }
+
+    /// How the last release ended, once (for a UI's note).
+    pub fn take_release_outcome(&mut self) -> Option<ReleaseOutcome> {
+        self.release.take_outcome()
     }
 
     /// Whether the controller's session has been joined (commands go out only then).
@@ -176,16 +186,16 @@ impl Operator {
                 self.command_changed = true;
             }
             Action::Release => {
-                if self.release_armed(now_ms) {
+                if !self.release_armed(now_ms) {
+                    self.release_armed_at_ms = Some(now_ms);
+                } else {
                     self.release_armed_at_ms = None;
-                    if self.estop_latched {
+                    if self.release.start(now_ms) {
                         self.estop_latched = false;
                         self.estop_confirmed = false;
                         self.latch_sent_ms = None;
-                        self.pending_estop = Some(EStopAction::Clear);
+                        self.pending_estop = None;
                     }
-                } else {
-                    self.release_armed_at_ms = Some(now_ms);
                 }
             }
             Action::Quit => return Outcome::Quit,
@@ -195,9 +205,10 @@ impl Operator {
 
     /// The frames due at `now_ms`: an E-stop latch or release at once (a latch again every
     /// [`LATCH_REPEAT_MS`] until the controller confirms it: a lost latch frame must not leave
-    /// the robot moving), the command at once when it changed, and the command and heartbeat
-    /// every [`PERIOD_MS`]. Until the controller's session is joined only a latch goes out; a
-    /// release waits for the controller's token.
+    /// the robot moving; a release again every [`RELEASE_REPEAT_MS`] until the controller
+    /// leaves its E-stop, for at most [`RELEASE_TIMEOUT_MS`]), the command at once when it
+    /// changed, and the command and heartbeat every [`PERIOD_MS`]. Until the controller's
+    /// session is joined only a latch goes out.
     pub fn poll(&mut self, now_ms: u64) -> Result<Vec<Frame>, EncodeError> {
         let mut frames = Vec::with_capacity(3);
         let repeat_latch = self.estop_latched
@@ -209,20 +220,17 @@ impl Operator {
             self.pending_estop = Some(EStopAction::Latch);
         }
         if let Some(action) = self.pending_estop.take() {
-            let estop = match action {
-                EStopAction::Latch => {
-                    self.latch_sent_ms = Some(now_ms);
-                    Some(EStop::latch(NodeId::Teleop))
-                }
-                EStopAction::Clear => self
-                    .release_token
-                    .map(|token| EStop::release(NodeId::Teleop, token)),
-            };
-            match estop.map(|estop| self.link.seal(&AnyMessage::EStop(estop))) {
-                Some(Ok(Some(frame))) => frames.push(frame),
-                Some(Err(error)) => return Err(error),
-                // Not joined yet, or no token heard: the release waits.
-                Some(Ok(None)) | None => self.pending_estop = Some(action),
+            self.latch_sent_ms = Some(now_ms);
+            let latch = AnyMessage::EStop(EStop::latch(NodeId::Teleop));
+            match self.link.seal(&latch)? {
+                Some(frame) => frames.push(frame),
+                None => self.pending_estop = Some(action),
+            }
+        }
+        if let Some(release) = self.release.due(now_ms) {
+            if let Some(frame) = self.link.seal(&AnyMessage::EStop(release))? {
+                self.release.sent(now_ms);
+                frames.push(frame);
             }
         }
         let periodic = now_ms >= self.next_send_ms;
@@ -253,7 +261,7 @@ mod tests {
     use crate::keys::{action, Key};
     use protocol::{
         Angle, Announce, BodyHeight, ControllerStatus, Epoch, FaultFlags, MessageId, Receiver,
-        Sender, Session, Tick, WireVersion,
+        ReleaseToken, Sender, Session, Tick, WireVersion,
     };
 
     /// The controller's side of the session, as far as an operator hears and is heard.
@@ -277,6 +285,7 @@ mod tests {
             let announce = AnyMessage::Announce(Announce {
                 version: WireVersion::THIS,
                 epoch: Epoch::new(7),
+                time: self.session.time(),
             });
             self.sender.seal(&self.session, &announce).unwrap()
         }
