@@ -34,8 +34,8 @@ fn sends_the_bus_schedule_at_250_hz() {
     assert_eq!(counts[&MessageId::WheelCommand], 250);
     assert_eq!(counts[&MessageId::ControllerStatus], 50);
     assert_eq!(counts[&MessageId::RejectCounters], 10);
-    // The session announcement on the first poll, then at 10 Hz (phase 14 of 25 ticks).
-    assert_eq!(counts[&MessageId::Announce], 1 + 10);
+    // The session announcement on the first poll, then at 50 Hz.
+    assert_eq!(counts[&MessageId::Announce], 1 + 50);
     assert_eq!(node.encode_failures(), 0);
 }
 

@@ -5,7 +5,9 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use crate::dlc::{fd_padded_len, MAX_FD_LEN};
-use crate::e2e::{self, Check, Freshness, Protection, HEADER_LEN};
+use crate::e2e::{self, Check, Freshness, MacKey, Protection, HEADER_LEN};
+#[cfg(doc)]
+use crate::e2e::PreparedKey;
 use crate::error::DecodeError;
 use crate::frame::Frame;
 use crate::id::MessageId;
@@ -91,6 +93,17 @@ pub fn encode<M: Message>(
     session: &Session,
     counter: u32,
 ) -> Result<Frame, EncodeError> {
+    encode_keyed(message, address, session, session.key(), counter)
+}
+
+/// As [`encode`], computing a MAC with `key` (the session's key, [prepared](PreparedKey)).
+pub fn encode_keyed<M: Message, K: MacKey + ?Sized>(
+    message: &M,
+    address: M::Address,
+    session: &Session,
+    key: &K,
+    counter: u32,
+) -> Result<Frame, EncodeError> {
     let id = M::id(address);
     let (protection, covered) = message.protection();
     let epoch = if protection.bound {
@@ -117,7 +130,7 @@ pub fn encode<M: Message>(
     };
     e2e::protect(
         protection.check,
-        session.key(),
+        key,
         &freshness,
         buf.get_mut(..HEADER_LEN + covered)
             .ok_or(EncodeError::TooLarge)?,

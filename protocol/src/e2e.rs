@@ -18,8 +18,7 @@
 //! A CMAC is the first four bytes of the 16-byte tag, read little-endian; CRC-32C is
 //! Castagnoli's polynomial (0x1EDC6F41, reflected, init and xor-out 0xFFFFFFFF).
 
-use aes::Aes128;
-use cmac::{Cmac, Mac};
+use crate::cmac::CmacKey;
 use crc::{Crc, CRC_32_ISCSI};
 
 use crate::session::{Epoch, Key};
@@ -86,8 +85,45 @@ impl Freshness {
     }
 }
 
+/// A key ready to compute CMACs: the AES key schedule and the CMAC subkeys, computed once.
+/// A node that checks or seals many frames keeps one ([`Sender`](crate::Sender) and
+/// [`Receiver`](crate::Receiver) do), so that a MAC costs its blocks and nothing more.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PreparedKey(CmacKey);
+
+impl PreparedKey {
+    /// `key`, prepared.
+    pub fn new(key: &Key) -> Self {
+        PreparedKey(CmacKey::new(&key.0))
+    }
+}
+
+/// What a CMAC is computed with: a [`Key`] (prepared anew for every MAC) or a
+/// [`PreparedKey`].
+pub trait MacKey {
+    /// The CMAC tag of the concatenation of `parts`.
+    fn tag(&self, parts: &[&[u8]]) -> [u8; 16];
+}
+
+impl MacKey for Key {
+    fn tag(&self, parts: &[&[u8]]) -> [u8; 16] {
+        CmacKey::new(&self.0).tag(parts)
+    }
+}
+
+impl MacKey for PreparedKey {
+    fn tag(&self, parts: &[&[u8]]) -> [u8; 16] {
+        self.0.tag(parts)
+    }
+}
+
 /// The check value of `payload` under `freshness`.
-pub fn check_value(check: Check, key: &Key, freshness: &Freshness, payload: &[u8]) -> u32 {
+pub fn check_value<K: MacKey + ?Sized>(
+    check: Check,
+    key: &K,
+    freshness: &Freshness,
+    payload: &[u8],
+) -> u32 {
     let prefix = freshness.bytes();
     match check {
         Check::Crc => {
@@ -97,10 +133,7 @@ pub fn check_value(check: Check, key: &Key, freshness: &Freshness, payload: &[u8
             digest.finalize()
         }
         Check::Mac => {
-            let mut mac = <Cmac<Aes128> as cmac::digest::KeyInit>::new(&key.0.into());
-            mac.update(&prefix);
-            mac.update(payload);
-            let tag = mac.finalize().into_bytes();
+            let tag = key.tag(&[&prefix, payload]);
             let mut first = [0; 4];
             for (slot, byte) in first.iter_mut().zip(tag.iter()) {
                 *slot = *byte;
@@ -113,7 +146,12 @@ pub fn check_value(check: Check, key: &Key, freshness: &Freshness, payload: &[u8
 /// Writes check value and counter into the first [`HEADER_LEN`] bytes of `message`, whose
 /// payload is already in place after them. Does nothing if `message` is shorter than the
 /// header.
-pub fn protect(check: Check, key: &Key, freshness: &Freshness, message: &mut [u8]) -> Option<()> {
+pub fn protect<K: MacKey + ?Sized>(
+    check: Check,
+    key: &K,
+    freshness: &Freshness,
+    message: &mut [u8],
+) -> Option<()> {
     let low = (freshness.counter & 0xFFFF) as u16;
     message
         .get_mut(4..HEADER_LEN)?
@@ -194,9 +232,9 @@ impl Search {
     /// and a node that may have joined late tries 2^8 (2^24 frames: 4.6 h at 1 kHz).
     pub const fn new(check: Check, owner: bool, reference: u32) -> Self {
         let tries = match (check, owner) {
-            (Check::Crc, _) => 1 << 12,
+            (Check::Crc, _) => 1_u32 << 12_u32,
             (Check::Mac, true) => 2,
-            (Check::Mac, false) => 1 << 8,
+            (Check::Mac, false) => 1_u32 << 8_u32,
         };
         Self { reference, tries }
     }

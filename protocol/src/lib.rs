@@ -84,7 +84,9 @@
     allow(clippy::unwrap_used, clippy::indexing_slicing, clippy::panic)
 )]
 
+pub mod aes;
 pub mod busload;
+pub mod cmac;
 mod codec;
 pub mod dbc;
 pub mod dlc;

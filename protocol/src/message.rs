@@ -1,6 +1,7 @@
 //! Any message of the bus, decoded from a raw identifier and data.
 
-use crate::codec::{decode, encode, EncodeError, Message};
+use crate::codec::{decode, encode_keyed, EncodeError, Message};
+use crate::e2e::MacKey;
 use crate::e2e::{Protection, HEADER_LEN};
 use crate::error::DecodeError;
 use crate::frame::Frame;
@@ -154,20 +155,30 @@ impl AnyMessage {
 
     /// Encodes this message with the sender's full counter `counter` under `session`.
     pub fn encode(&self, session: &Session, counter: u32) -> Result<Frame, EncodeError> {
+        self.encode_keyed(session, session.key(), counter)
+    }
+
+    /// As [`AnyMessage::encode`], computing a MAC with `key` (the session's key, prepared).
+    pub fn encode_keyed<K: MacKey + ?Sized>(
+        &self,
+        session: &Session,
+        key: &K,
+        counter: u32,
+    ) -> Result<Frame, EncodeError> {
         match self {
-            AnyMessage::EStop(m) => encode(m, (), session, counter),
-            AnyMessage::Sync(m) => encode(m, (), session, counter),
-            AnyMessage::Announce(m) => encode(m, (), session, counter),
-            AnyMessage::LegTargets(m) => encode(m, (), session, counter),
-            AnyMessage::WheelCommand(m) => encode(m, (), session, counter),
-            AnyMessage::LegFeedback(leg, m) => encode(m, *leg, session, counter),
-            AnyMessage::WheelFeedback(m) => encode(m, (), session, counter),
-            AnyMessage::Imu(m) => encode(m, (), session, counter),
-            AnyMessage::TeleopCommand(m) => encode(m, (), session, counter),
-            AnyMessage::TeleopHeartbeat(m) => encode(m, (), session, counter),
-            AnyMessage::ControllerStatus(m) => encode(m, (), session, counter),
-            AnyMessage::DriveStatus(drive, m) => encode(m, *drive, session, counter),
-            AnyMessage::RejectCounters(m) => encode(m, (), session, counter),
+            AnyMessage::EStop(m) => encode_keyed(m, (), session, key, counter),
+            AnyMessage::Sync(m) => encode_keyed(m, (), session, key, counter),
+            AnyMessage::Announce(m) => encode_keyed(m, (), session, key, counter),
+            AnyMessage::LegTargets(m) => encode_keyed(m, (), session, key, counter),
+            AnyMessage::WheelCommand(m) => encode_keyed(m, (), session, key, counter),
+            AnyMessage::LegFeedback(leg, m) => encode_keyed(m, *leg, session, key, counter),
+            AnyMessage::WheelFeedback(m) => encode_keyed(m, (), session, key, counter),
+            AnyMessage::Imu(m) => encode_keyed(m, (), session, key, counter),
+            AnyMessage::TeleopCommand(m) => encode_keyed(m, (), session, key, counter),
+            AnyMessage::TeleopHeartbeat(m) => encode_keyed(m, (), session, key, counter),
+            AnyMessage::ControllerStatus(m) => encode_keyed(m, (), session, key, counter),
+            AnyMessage::DriveStatus(drive, m) => encode_keyed(m, *drive, session, key, counter),
+            AnyMessage::RejectCounters(m) => encode_keyed(m, (), session, key, counter),
         }
     }
 }

@@ -1,6 +1,6 @@
 //! The receiving side of the bus: verify, sequence-check, decode and count every rejection.
 
-use crate::e2e::{self, E2eChecker, E2eStatus, Freshness, Search, HEADER_LEN};
+use crate::e2e::{self, E2eChecker, E2eStatus, Freshness, PreparedKey, Search, HEADER_LEN};
 use crate::error::{DecodeError, RejectCause};
 use crate::id::MessageId;
 use crate::message::{decode_frame, protection_of, AnyMessage};
@@ -30,6 +30,7 @@ pub struct Accepted {
 #[derive(Debug, Clone)]
 pub struct Receiver {
     session: Session,
+    key: PreparedKey,
     owner: bool,
     checkers: [E2eChecker; MessageId::ALL.len()],
     counters: RejectCounters,
@@ -37,17 +38,18 @@ pub struct Receiver {
 
 impl Receiver {
     /// The controller's receiver: `session` is its own.
-    pub const fn owner(session: Session) -> Self {
+    pub fn owner(session: Session) -> Self {
         Self::new(session, true)
     }
 
     /// Any other node's receiver: it joins the session the controller announces.
-    pub const fn member(key: Key) -> Self {
+    pub fn member(key: Key) -> Self {
         Self::new(Session::unjoined(key), false)
     }
 
-    const fn new(session: Session, owner: bool) -> Self {
+    fn new(session: Session, owner: bool) -> Self {
         Self {
+            key: PreparedKey::new(session.key()),
             session,
             owner,
             checkers: [E2eChecker::new(); MessageId::ALL.len()],
@@ -119,14 +121,14 @@ impl Receiver {
         let payload = data
             .get(HEADER_LEN..HEADER_LEN + covered)
             .ok_or(wrong_length)?;
-        let key = *self.session.key();
+        let key = &self.key;
         let verify = |counter: u32| {
             let freshness = Freshness {
                 data_id: id.data_id(),
                 epoch,
                 counter,
             };
-            e2e::check_value(protection.check, &key, &freshness, payload) == sent
+            e2e::check_value(protection.check, key, &freshness, payload) == sent
         };
         let status = if protection.sequenced {
             let checker = self

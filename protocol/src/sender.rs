@@ -6,7 +6,8 @@ use crate::id::MessageId;
 use crate::message::AnyMessage;
 use crate::msg::{EStop, CLASSIC_LATCH_LEN};
 use crate::node::NodeId;
-use crate::session::{Epoch, Session, TEST_KEY};
+use crate::e2e::PreparedKey;
+use crate::session::{Epoch, Key, Session, TEST_KEY};
 
 /// Seals a node's messages: hands out each identifier's full counter and protects the frame
 /// under the node's session. In every session it is in, a sender starts all its counters at the
@@ -14,6 +15,7 @@ use crate::session::{Epoch, Session, TEST_KEY};
 /// the same session sends counters above those of its previous life.
 #[derive(Debug, Clone)]
 pub struct Sender {
+    key: Option<(Key, PreparedKey)>,
     epoch: Option<Epoch>,
     counters: [u32; MessageId::ALL.len()],
 }
@@ -28,6 +30,7 @@ impl Sender {
     /// A sender that has sent nothing.
     pub const fn new() -> Self {
         Self {
+            key: None,
             epoch: None,
             counters: [0; MessageId::ALL.len()],
         }
@@ -49,7 +52,14 @@ impl Sender {
         if message.id() == MessageId::EStop {
             *slot = (*slot).max(now);
         }
-        let frame = message.encode(session, *slot)?;
+        let key = match &self.key {
+            Some((key, prepared)) if key == session.key() => prepared,
+            _ => {
+                let prepared = PreparedKey::new(session.key());
+                &self.key.insert((*session.key(), prepared)).1
+            }
+        };
+        let frame = message.encode_keyed(session, key, *slot)?;
         *slot = slot.wrapping_add(1);
         Ok(frame)
     }

@@ -231,7 +231,7 @@ fn out_of_range_values_are_rejected_even_with_a_valid_check() {
     only_cause(&rx, RejectCause::OutOfRange);
     let imu = encode(
         &Imu {
-            orientation: [QuatComponent::from_si(1.0).unwrap(); 4],
+            orientation: [QuatComponent::from_si(1.0).unwrap(); 3],
             angular_rate: [AngularRate::default(); 3],
             acceleration: [Acceleration::default(); 3],
         },

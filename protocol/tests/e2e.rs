@@ -60,6 +60,23 @@ fn a_gap_is_ok_some_lost() {
     assert_eq!(checker.last(), Some(30));
 }
 
+/// A sender counts one frame a millisecond at most: a jump ahead by more frames than
+/// milliseconds passed since the last accepted frame (with 100 ms of slack for a member's view
+/// of the time) is a sender that restarted at the session time, not a loss.
+#[test]
+fn a_jump_past_the_elapsed_time_is_a_restart_not_a_loss() {
+    let at = |reference| Search::new(Check::Mac, true, reference);
+    let mut checker = E2eChecker::new();
+    let mut offer_at = |sent: u32, now: u32| checker.check(sent as u16, at(now), |f| f == sent);
+    assert_eq!(offer_at(1_000, 1_000), E2eStatus::Initial);
+    // 300 ms later: up to 400 frames lost is a loss, 401 a restart.
+    assert_eq!(offer_at(1_401, 1_300), E2eStatus::OkSomeLost { lost: 400 });
+    assert_eq!(offer_at(1_803, 1_600), E2eStatus::Initial);
+    assert_eq!(offer_at(1_804, 1_600), E2eStatus::Ok);
+    // A slow sender's loss: 9 frames in 500 ms.
+    assert_eq!(offer_at(1_814, 2_100), E2eStatus::OkSomeLost { lost: 9 });
+}
+
 #[test]
 fn the_same_counter_twice_is_repeated() {
     let mut checker = checker_after(&[10]);
@@ -230,13 +247,8 @@ fn the_search_never_finds_a_counter_at_or_behind_the_last_accepted() {
             reference: u32::MAX,
             tries: 1 << 16,
         };
-        assert_eq!(
-            checker
-                .check(sent as u16, search, |full| full == sent)
-                .is_accepted(),
-            false,
-            "{sent:#x}"
-        );
+        let status = checker.check(sent as u16, search, |full| full == sent);
+        assert!(!status.is_accepted(), "{sent:#x}: {status:?}");
         assert_eq!(checker.last(), Some(last));
     }
 }

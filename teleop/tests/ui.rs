@@ -187,6 +187,7 @@ fn keys_go_out_as_frames_and_the_estop_shows_until_released() {
         201,
         &robot.status(ControllerMode::Stop, FaultFlags::AWAITING_STOP),
     );
+    app.poll(201).unwrap();
     let shown = screen(&app, 201);
     assert!(
         !shown.contains("E-STOP LATCHED") && !shown.contains("E-STOP SENT"),

@@ -60,6 +60,7 @@ pub struct Node {
     release_token: ReleaseToken,
     announced: bool,
     started: Option<Tick>,
+    advanced: Option<Tick>,
     encode_failures: u32,
 }
 
@@ -83,6 +84,7 @@ impl Node {
             release_token: ReleaseToken::new(0),
             announced: false,
             started: None,
+            advanced: None,
             encode_failures: 0,
         })
     }
@@ -167,6 +169,10 @@ impl Node {
     /// The session time is the time since this node's first call: what every sender's
     /// counters start at.
     fn advance(&mut self, now: Tick) {
+        if self.advanced == Some(now) {
+            return;
+        }
+        self.advanced = Some(now);
         let started = *self.started.get_or_insert(now);
         let ms = self
             .controller

@@ -8,7 +8,8 @@ use crate::signal::{array, scalar, Field};
 use crate::units::{Angle, DriveEnable};
 
 /// Position targets of all 16 leg joints, id `0x100`, controller → leg drives. Each leg drive
-/// servos its four joints to their targets (the report's position actuators).
+/// servos its four joints to their targets (the report's position actuators). CRC-protected,
+/// not authenticated, like [`WheelCommand`](crate::WheelCommand).
 ///
 /// | byte   | field      | type     | meaning                                              |
 /// |--------|------------|----------|------------------------------------------------------|
@@ -39,7 +40,6 @@ impl Message for LegTargets {
         scalar::<DriveEnable>("enable"),
         array::<Angle>("position", &JOINT_NAMES),
     ];
-    const PROTECTION: crate::e2e::Protection = crate::e2e::AUTHENTICATED;
     fn id(_: ()) -> MessageId {
         MessageId::LegTargets
     }

@@ -73,19 +73,14 @@ pub fn any_message() -> impl Strategy<Value = AnyMessage> {
                 }
             )),
         (
-            proptest::array::uniform2(wheel_angle()),
             proptest::array::uniform2(wheel_velocity()),
             proptest::array::uniform2(torque())
         )
-            .prop_map(|(position, velocity, effort)| AnyMessage::WheelFeedback(
-                WheelFeedback {
-                    position,
-                    velocity,
-                    effort
-                }
-            )),
+            .prop_map(
+                |(velocity, effort)| AnyMessage::WheelFeedback(WheelFeedback { velocity, effort })
+            ),
         (
-            proptest::array::uniform4(quat()),
+            proptest::array::uniform3(quat()),
             proptest::array::uniform3(rate()),
             proptest::array::uniform3(accel())
         )

@@ -178,7 +178,7 @@ mod tests {
                 release.observe(&status(ControllerMode::Stop, 2));
             }
         }
-        assert_eq!(sent, [100, 150, 200, 250, 300]);
+        assert_eq!(sent, [100, 150, 200, 250, 300, 350]);
         assert!(!release.pending());
         assert_eq!(release.take_outcome(), Some(ReleaseOutcome::Released));
         assert_eq!(release.take_outcome(), None);
