@@ -122,38 +122,43 @@ impl Aes128 {
 
     /// Encrypts one block.
     pub fn encrypt(&self, block: &[u8; 16]) -> [u8; 16] {
-        let rk = |i: usize| self.round_keys.get(i).copied().unwrap_or(0);
+        let mut keys = self.round_keys.chunks_exact(4).map(|k| {
+            let mut round = [0_u32; 4];
+            round.copy_from_slice(k);
+            round
+        });
+        let first = keys.next().unwrap_or_default();
         let mut s = [0_u32; 4];
-        for (c, (word, chunk)) in s.iter_mut().zip(block.chunks_exact(4)).enumerate() {
+        for ((word, chunk), k) in s.iter_mut().zip(block.chunks_exact(4)).zip(first) {
             let mut bytes = [0_u8; 4];
             bytes.copy_from_slice(chunk);
-            *word = u32::from_be_bytes(bytes) ^ rk(c);
+            *word = u32::from_be_bytes(bytes) ^ k;
         }
-        for round in 1..10 {
+        let column = |a: u32, b: u32, c: u32, d: u32| {
+            te(a >> 24)
+                ^ te(b >> 16).rotate_right(8)
+                ^ te(c >> 8).rotate_right(16)
+                ^ te(d).rotate_right(24)
+        };
+        for [k0, k1, k2, k3] in keys.by_ref().take(9) {
             let [s0, s1, s2, s3] = s;
-            let column = |a: u32, b: u32, c: u32, d: u32, k: usize| {
-                te(a >> 24)
-                    ^ te(b >> 16).rotate_right(8)
-                    ^ te(c >> 8).rotate_right(16)
-                    ^ te(d).rotate_right(24)
-                    ^ rk(4 * round + k)
-            };
             s = [
-                column(s0, s1, s2, s3, 0),
-                column(s1, s2, s3, s0, 1),
-                column(s2, s3, s0, s1, 2),
-                column(s3, s0, s1, s2, 3),
+                column(s0, s1, s2, s3) ^ k0,
+                column(s1, s2, s3, s0) ^ k1,
+                column(s2, s3, s0, s1) ^ k2,
+                column(s3, s0, s1, s2) ^ k3,
             ];
         }
+        let [k0, k1, k2, k3] = keys.next().unwrap_or_default();
         let [s0, s1, s2, s3] = s;
-        let last = |a: u32, b: u32, c: u32, d: u32, k: usize| {
-            (sub(a >> 24) << 24 | sub(b >> 16) << 16 | sub(c >> 8) << 8 | sub(d)) ^ rk(40 + k)
+        let last = |a: u32, b: u32, c: u32, d: u32| {
+            sub(a >> 24) << 24 | sub(b >> 16) << 16 | sub(c >> 8) << 8 | sub(d)
         };
         let out = [
-            last(s0, s1, s2, s3, 0),
-            last(s1, s2, s3, s0, 1),
-            last(s2, s3, s0, s1, 2),
-            last(s3, s0, s1, s2, 3),
+            last(s0, s1, s2, s3) ^ k0,
+            last(s1, s2, s3, s0) ^ k1,
+            last(s2, s3, s0, s1) ^ k2,
+            last(s3, s0, s1, s2) ^ k3,
         ];
         let mut bytes = [0_u8; 16];
         for (chunk, word) in bytes.chunks_exact_mut(4).zip(out) {

@@ -148,6 +148,25 @@ pub const SCHEDULE: [Slot; 20] = [
     slot(MessageId::DriveStatus(Drive::Wheel), Period::Hz(10), 35),
 ];
 
+/// `SLOT_OF[id.index()]`: the position of `id`'s slot in [`SCHEDULE`] (`u8::MAX`: none).
+const SLOT_OF: [u8; MessageId::ALL.len()] = slot_of_table();
+
+const fn slot_of_table() -> [u8; MessageId::ALL.len()] {
+    let mut table = [u8::MAX; MessageId::ALL.len()];
+    let mut n = 0;
+    while n < SCHEDULE.len() {
+        table[SCHEDULE[n].id.index()] = n as u8;
+        n += 1;
+    }
+    table
+}
+
+/// The schedule's slot for `id`, found without a search (the controller asks every tick).
+pub fn slot_of(id: MessageId) -> Option<&'static Slot> {
+    let at = *SLOT_OF.get(id.index())?;
+    SCHEDULE.get(usize::from(at))
+}
+
 impl Slot {
     /// Cycles between two frames at `control_hz` (0 for sporadic).
     pub const fn period_cycles(&self, control_hz: u32) -> u32 {

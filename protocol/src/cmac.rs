@@ -97,7 +97,11 @@ mod tests {
             (40, "dfa66747de9ae63030ca32611497c827"),
             (64, "51f0bebf7e3b9d92fc49741779363cfe"),
         ] {
-            assert_eq!(key.tag(&[&message[..len]]).to_vec(), hex(tag), "{len} bytes");
+            assert_eq!(
+                key.tag(&[&message[..len]]).to_vec(),
+                hex(tag),
+                "{len} bytes"
+            );
         }
         // Split anywhere, the same message has the same tag.
         assert_eq!(

@@ -5,9 +5,9 @@ use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 use crate::dlc::{fd_padded_len, MAX_FD_LEN};
-use crate::e2e::{self, Check, Freshness, MacKey, Protection, HEADER_LEN};
 #[cfg(doc)]
 use crate::e2e::PreparedKey;
+use crate::e2e::{self, Check, Freshness, MacKey, Protection, HEADER_LEN};
 use crate::error::DecodeError;
 use crate::frame::Frame;
 use crate::id::MessageId;

@@ -70,18 +70,10 @@ pub struct Freshness {
 
 impl Freshness {
     fn bytes(&self) -> [u8; 10] {
-        let mut out = [0; 10];
-        let epoch: u32 = self.epoch.map_or(0, Epoch::raw);
-        for (slot, byte) in out.iter_mut().zip(
-            self.data_id
-                .to_le_bytes()
-                .into_iter()
-                .chain(epoch.to_le_bytes())
-                .chain(self.counter.to_le_bytes()),
-        ) {
-            *slot = byte;
-        }
-        out
+        let [d0, d1] = self.data_id.to_le_bytes();
+        let [e0, e1, e2, e3] = self.epoch.map_or(0, Epoch::raw).to_le_bytes();
+        let [c0, c1, c2, c3] = self.counter.to_le_bytes();
+        [d0, d1, e0, e1, e2, e3, c0, c1, c2, c3]
     }
 }
 
@@ -210,13 +202,15 @@ impl E2eStatus {
 }
 
 /// Where a receiver looks for a frame that does not follow the sequence it knows (or the
-/// first frame of a sender it has not heard): the high halves from the one after
-/// `reference`'s down, at most `tries` of them, and only counters after the last accepted one.
+/// first frame of a sender it has not heard): first the counter with the frame's low half
+/// nearest `reference` (within ±2^15), then one and more periods of 2^16 below it, `tries`
+/// candidates in all, and only counters after the last accepted one.
 ///
-/// A sender starts its counters at the session time it joins at (see [`crate::session`]) and
-/// counts one per frame from there, so a sender that restarted, a receiver that joined late,
-/// and a sequence with a gap of 2^15 frames or more are all found within a few halves of the
-/// session time, while a replay (at or behind the last accepted counter) never is.
+/// A sender's counters stay within [`MAX_LAG_MS`] below the session time (see
+/// [`crate::session`]), so a sender that restarted, a receiver that joined late, and a
+/// sequence with a gap of 2^15 frames or more are found at the first candidate, while a replay
+/// (at or behind the last accepted counter, or older than the candidates reach: about 97 s) is
+/// not.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Search {
     /// The receiver's session time, ms.
@@ -225,18 +219,33 @@ pub struct Search {
     pub tries: u32,
 }
 
+/// How far a sender's counter may fall behind the session time before it jumps to it, ms: a
+/// sender slower than one frame per millisecond falls behind, and the receivers' search
+/// ([`Search`]) only looks so far back.
+pub const MAX_LAG_MS: u32 = 1 << 14;
+
 impl Search {
-    /// The search a receiver makes for `check`: a CRC is cheap and anyone can forge one anyway,
-    /// so it is tried over 2^12 halves (2^28 frames); a MAC costs a block cipher run per try, so
-    /// the controller (`owner`), which has heard every sender since its session opened, tries 2
-    /// and a node that may have joined late tries 2^8 (2^24 frames: 4.6 h at 1 kHz).
-    pub const fn new(check: Check, owner: bool, reference: u32) -> Self {
-        let tries = match (check, owner) {
-            (Check::Crc, _) => 1_u32 << 12_u32,
-            (Check::Mac, true) => 2,
-            (Check::Mac, false) => 1_u32 << 8_u32,
+    /// The search a receiver makes at session time `reference`: two candidates, the nearest
+    /// and one period below (a CMAC costs a block cipher run per try).
+    pub const fn new(reference: u32) -> Self {
+        Self {
+            reference,
+            tries: 2,
+        }
+    }
+
+    /// The candidate full counters for low half `low`, nearest `reference` first.
+    fn candidates(self, low: u16) -> impl Iterator<Item = u32> {
+        let low = u32::from(low);
+        let same = self.reference & !0xFFFF | low;
+        let nearest = if same > self.reference.saturating_add(0x8000) {
+            same.checked_sub(0x1_0000)
+        } else if same.saturating_add(0x8000) < self.reference {
+            same.checked_add(0x1_0000)
+        } else {
+            Some(same)
         };
-        Self { reference, tries }
+        (0..self.tries).map_while(move |n| nearest?.checked_sub(n.checked_mul(0x1_0000)?))
     }
 }
 
@@ -263,7 +272,7 @@ impl E2eChecker {
 
     /// Forgets the sequence (a new session restarts every sender).
     pub fn reset(&mut self) {
-        self.last = None;
+        *self = Self::new();
     }
 
     /// The last accepted full counter.
@@ -312,12 +321,10 @@ impl E2eChecker {
                 }
             }
         }
-        let first_high = ((search.reference >> 16_u32) + 1).min(0xFFFF);
-        let floor = self.last.map_or(0, |last| last >> 16_u32);
-        let found = (0..search.tries)
-            .map_while(|n| first_high.checked_sub(n).filter(|high| *high >= floor))
-            .map(|high| high << 16_u32 | u32::from(low))
-            .filter(|full| self.last.is_none_or(|last| *full > last))
+        let last = self.last;
+        let found = search
+            .candidates(low)
+            .filter(|full| last.is_none_or(|last| *full > last))
             .find(|full| verify(*full));
         match found {
             Some(full) => {

@@ -77,10 +77,11 @@ impl Receiver {
     pub fn receive(&mut self, raw_id: u16, data: &[u8]) -> Result<Accepted, DecodeError> {
         let result = self.check(raw_id, data);
         match &result {
+            // E-stop releases count with the session time: their gaps are not losses.
             Ok(Accepted {
                 status: E2eStatus::OkSomeLost { lost },
                 ..
-            }) => self.counters.record_lost(*lost),
+            }) if raw_id != MessageId::EStop.raw() => self.counters.record_lost(*lost),
             Ok(_) => {}
             Err(error) => self.counters.record(error.cause()),
         }
@@ -135,7 +136,7 @@ impl Receiver {
                 .checkers
                 .get_mut(id.index())
                 .ok_or(DecodeError::UnknownId(raw_id))?;
-            let search = Search::new(protection.check, self.owner, self.session.time().ms());
+            let search = Search::new(self.session.time().ms());
             checker.check(low, search, verify)
         } else if verify(u32::from(low)) {
             E2eStatus::Initial

@@ -1,18 +1,19 @@
 //! The sending side of the bus: one counter per identifier, started at the session time.
 
 use crate::codec::EncodeError;
+use crate::e2e::{PreparedKey, MAX_LAG_MS};
 use crate::frame::Frame;
 use crate::id::MessageId;
 use crate::message::AnyMessage;
 use crate::msg::{EStop, CLASSIC_LATCH_LEN};
 use crate::node::NodeId;
-use crate::e2e::PreparedKey;
 use crate::session::{Epoch, Key, Session, TEST_KEY};
 
 /// Seals a node's messages: hands out each identifier's full counter and protects the frame
 /// under the node's session. In every session it is in, a sender starts all its counters at the
 /// session time of its first frame there (see [`crate::session`]), so that a node restarted in
-/// the same session sends counters above those of its previous life.
+/// the same session sends counters above those of its previous life, and moves a counter up to
+/// the session time when it has fallen [`MAX_LAG_MS`] behind.
 #[derive(Debug, Clone)]
 pub struct Sender {
     key: Option<(Key, PreparedKey)>,
@@ -49,7 +50,7 @@ impl Sender {
             .counters
             .get_mut(message.id().index())
             .ok_or(EncodeError::TooLarge)?;
-        if message.id() == MessageId::EStop {
+        if message.id() == MessageId::EStop || slot.saturating_add(MAX_LAG_MS) < now {
             *slot = (*slot).max(now);
         }
         let key = match &self.key {

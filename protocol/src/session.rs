@@ -8,16 +8,19 @@
 //! the announcement and from then on binds each frame to the session: the frame's check value
 //! covers the epoch and the frame's full 32-bit counter, of which only the low 16 bits travel.
 //!
-//! A sender starts its counters at the session time it (re)joins at and counts one per frame,
-//! so at up to one frame per millisecond on an identifier its counter never passes the session
-//! time: a node that restarts in the same session starts above everything it sent before, and
-//! a receiver that joins late, or misses 2^15 frames, finds the counter within a few high
-//! halves of the session time ([`Search`](crate::e2e::Search)). A frame recorded in an earlier
-//! session fails its check in this one; a frame recorded earlier in this session is at or behind
-//! the receiver's counter, and a receiver only ever accepts a counter after the last it
-//! accepted. Replays are refused, not merely rare. The E-stop **release** counts with the
-//! session time itself (the greater of its next counter and the time), so that two operators
-//! releasing on one identifier both stay ahead.
+//! A sender starts its counters at the session time it (re)joins at and counts one per frame;
+//! a sender slower than one frame per millisecond falls behind the session time, and jumps to
+//! it when it is [`MAX_LAG_MS`](crate::e2e::MAX_LAG_MS) behind. At up to one frame per
+//! millisecond on an identifier its counter never passes the session time, so a node that
+//! restarts in the same session starts above everything it sent before, and a receiver that
+//! joins late, or misses 2^15 frames, finds the counter near the session time
+//! ([`Search`](crate::e2e::Search)); a jump further than the time elapsed restarts the
+//! sequence rather than counting as loss. A frame recorded in an earlier session fails its
+//! check in this one; a frame recorded earlier in this session is at or behind the receiver's
+//! counter, or too old for its search, and a receiver only ever accepts a counter after the
+//! last it accepted. Replays are refused, not merely rare. The E-stop **release** counts with
+//! the session time itself (the greater of its next counter and the time), so that two
+//! operators releasing on one identifier both stay ahead.
 //!
 //! Operator commands, E-stop releases and the announcement carry a truncated CMAC-AES-128 as
 //! their check value, so that a node without the key cannot command the controller or release
@@ -39,8 +42,15 @@ pub const WIRE_VERSION: u8 = 2;
 ///
 /// Real keys live outside the repository (see `docs/protocol.md`, "Keys"); [`TEST_KEY`] is for
 /// simulation and CI, and a robot built with it is open to anyone who reads this file.
-#[derive(Clone, Copy, PartialEq, Eq)]
+#[derive(Clone, Copy, Eq)]
 pub struct Key(pub [u8; 16]);
+
+impl PartialEq for Key {
+    /// As one 128-bit word: no call and no early exit per byte.
+    fn eq(&self, other: &Key) -> bool {
+        u128::from_ne_bytes(self.0) == u128::from_ne_bytes(other.0)
+    }
+}
 
 impl core::fmt::Debug for Key {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {

@@ -60,7 +60,7 @@ impl Sensors {
     /// Stores an IMU sample. A quaternion that gives no attitude (all zero) does not count as a
     /// sample.
     pub fn record_imu(&mut self, now: Tick, imu: &Imu) {
-        let attitude = Attitude::from_quaternion(imu.quaternion());
+        let attitude = Attitude::from_quaternion(imu.quaternion(crate::math::sqrt));
         if attitude.tilt_rad().is_finite() {
             self.attitude = attitude;
             self.angular_rate_rad_s = imu.angular_rate.map(|w| w.si());

@@ -59,12 +59,13 @@ impl Imu {
         [x, y, z].map(|c| QuatComponent::saturating_from_si(sign * c))
     }
 
-    /// The orientation as a quaternion w, x, y, z, with w ≥ 0 recovered from x, y, z (0 when
-    /// wire rounding puts x² + y² + z² above 1).
-    pub fn quaternion(&self) -> [f32; 4] {
+    /// The orientation as a quaternion w, x, y, z, with w ≥ 0 recovered from x, y, z by
+    /// `sqrt` (the caller's: the MCU has a square-root instruction); w is 0 when wire rounding
+    /// puts x² + y² + z² above 1.
+    pub fn quaternion(&self, sqrt: impl Fn(f32) -> f32) -> [f32; 4] {
         let [x, y, z] = self.orientation.map(|c| c.si());
         let w_sq = 1.0 - (x * x + y * y + z * z);
-        let w = if w_sq > 0.0 { libm::sqrtf(w_sq) } else { 0.0 };
+        let w = if w_sq > 0.0 { sqrt(w_sq) } else { 0.0 };
         [w, x, y, z]
     }
 }
