@@ -16,13 +16,11 @@
 //! targets at up to 250 Hz, status at 50 Hz, the reject counters at 10 Hz.
 
 pub mod link;
-pub mod mac_budget;
 pub mod rate_limit;
 pub mod service;
 
 use heapless::Vec;
 use protocol::busload::slot_of;
-use protocol::{protection_of, Check};
 use protocol::{
     Angle, Announce, AnyMessage, BodyHeight, ControllerStatus, DecodeError, DriveEnable, EStop,
     EStopAction, Frame, LegTargets, MessageId, NodeId, Receiver, RejectCounters, ReleaseToken,
@@ -34,7 +32,6 @@ use crate::control::controller::{ConfigError, Controller, Output};
 use crate::control::fsm::State;
 use crate::time::Tick;
 use link::LinkMonitor;
-use mac_budget::MacBudget;
 use rate_limit::TickBudget;
 
 /// Most operator commands ([`MessageId::TeleopCommand`]) handed to the controller per control
@@ -57,7 +54,6 @@ pub type TickFrames = Vec<Frame, MAX_FRAMES_PER_TICK>;
 pub struct Node {
     receiver: Receiver,
     teleop_budget: TickBudget,
-    mac_budget: MacBudget,
     link: LinkMonitor,
     controller: Controller,
     sender: Sender,
@@ -82,7 +78,6 @@ impl Node {
         Ok(Self {
             receiver: Receiver::owner(session),
             teleop_budget: TickBudget::new(TELEOP_COMMANDS_PER_TICK),
-            mac_budget: MacBudget::new(),
             link,
             controller: Controller::new(config)?,
             sender: Sender::new(),
@@ -148,26 +143,8 @@ impl Node {
     /// some 1 650 frames/s, so leaving it out costs the measure nothing). Commands are limited,
     /// so their flood adds at most 2 frames per tick: at 20 % loss the measure still reads about
     /// 15 % at 250 Hz and 12 % at 1 kHz.
-    ///
-    /// An authenticated frame takes the tick's one CMAC ([`mac_budget`]); when it is spent the
-    /// frame waits for a later tick and this returns `Ok` (a frame refused then is counted by
-    /// cause like any other).
     pub fn on_frame(&mut self, now: Tick, raw_id: u16, data: &[u8]) -> Result<(), DecodeError> {
         self.advance(now);
-        let authenticated = MessageId::from_raw(raw_id)
-            .is_some_and(|id| protection_of(id, data).0.check == Check::Mac);
-        if authenticated && !self.mac_budget.take() {
-            let deferred = Frame::new(raw_id, data).is_some_and(|f| self.mac_budget.defer(f));
-            return if deferred {
-                Ok(())
-            } else {
-                Err(self.refuse(DecodeError::RateLimited { id: raw_id }))
-            };
-        }
-        self.accept(now, raw_id, data)
-    }
-
-    fn accept(&mut self, now: Tick, raw_id: u16, data: &[u8]) -> Result<(), DecodeError> {
         let accepted = self.receiver.receive(raw_id, data)?;
         if matches!(accepted.message, AnyMessage::TeleopCommand(_)) && !self.teleop_budget.take() {
             return Err(self.refuse(DecodeError::RateLimited { id: raw_id }));
@@ -191,23 +168,12 @@ impl Node {
 
     /// The session time is the time since this node's first call: what every sender's
     /// counters start at.
-    ///
-    /// A new tick also renews the CMAC budget: a due announcement reserves it, otherwise the
-    /// oldest deferred authenticated frame is taken now.
     fn advance(&mut self, now: Tick) {
         if self.advanced == Some(now) {
             return;
         }
         self.advanced = Some(now);
         self.set_time(now);
-        self.mac_budget.refill();
-        if self.announce_due(now) {
-            self.mac_budget.take();
-        } else if let Some(frame) = self.mac_budget.next_deferred() {
-            self.mac_budget.take();
-            // Its outcome is counted by the receiver; nobody waits for it.
-            let _ = self.accept(now, frame.id(), frame.data());
-        }
     }
 
     /// Whether the session announcement goes out in tick `now`.

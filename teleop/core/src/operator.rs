@@ -16,6 +16,10 @@ use crate::release::{Release, ReleaseOutcome};
 
 /// Period of the command and heartbeat, ms (50 Hz).
 pub const PERIOD_MS: u64 = 20;
+/// The heartbeat goes out this long after the periodic command, ms: half a period apart, so
+/// that the controller checks one authenticated frame per tick (a CMAC is the dearest thing it
+/// does with a frame; see the bus schedule's phases).
+pub const HEARTBEAT_OFFSET_MS: u64 = PERIOD_MS / 2;
 /// How often an unconfirmed E-stop latch is sent again, ms: one control period of the
 /// controller at 250 Hz, so that on a lossy link the latch gets through within a few of them.
 pub const LATCH_REPEAT_MS: u64 = 4;
@@ -48,6 +52,7 @@ pub struct Operator {
     pending_estop: Option<EStopAction>,
     command_changed: bool,
     next_send_ms: u64,
+    next_heartbeat_ms: u64,
     link: OperatorLink,
     release: Release,
 }
@@ -77,6 +82,7 @@ impl Operator {
             pending_estop: None,
             command_changed: true,
             next_send_ms: 0,
+            next_heartbeat_ms: 0,
             link,
             release: Release::default(),
         }
@@ -205,9 +211,10 @@ impl Operator {
 
     /// The frames due at `now_ms`: an E-stop latch or release at once (a latch again every
     /// [`LATCH_REPEAT_MS`] until the controller confirms it: a lost latch frame must not leave
-    /// the robot moving; a release again every [`RELEASE_REPEAT_MS`] until the controller
-    /// leaves its E-stop, for at most [`RELEASE_TIMEOUT_MS`]), the command at once when it
-    /// changed, and the command and heartbeat every [`PERIOD_MS`]. Until the controller's
+    /// the robot moving; a release again every [`RELEASE_REPEAT_MS`](crate::release::RELEASE_REPEAT_MS) until the controller
+    /// leaves its E-stop, for at most [`RELEASE_TIMEOUT_MS`](crate::release::RELEASE_TIMEOUT_MS)), the command at once when it
+    /// changed, and the command and heartbeat every [`PERIOD_MS`], the heartbeat
+    /// [`HEARTBEAT_OFFSET_MS`] after the command. Until the controller's
     /// session is joined only a latch goes out.
     pub fn poll(&mut self, now_ms: u64) -> Result<Vec<Frame>, EncodeError> {
         let mut frames = Vec::with_capacity(3);
@@ -242,14 +249,19 @@ impl Operator {
             });
             frames.extend(self.link.seal(&command)?);
             self.command_changed = false;
+            if periodic {
+                self.next_send_ms = now_ms - now_ms % PERIOD_MS + PERIOD_MS;
+            }
         }
-        if periodic {
+        if now_ms >= self.next_heartbeat_ms {
             let uptime = u32::try_from(now_ms).unwrap_or(u32::MAX);
             let heartbeat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
                 uptime: Millis::from_raw(uptime).unwrap_or(Millis::saturating_from_si(0.0)),
             });
             frames.extend(self.link.seal(&heartbeat)?);
-            self.next_send_ms = now_ms - now_ms % PERIOD_MS + PERIOD_MS;
+            // The next time after now at the heartbeat's phase of the period.
+            let ahead = (HEARTBEAT_OFFSET_MS + PERIOD_MS - now_ms % PERIOD_MS) % PERIOD_MS;
+            self.next_heartbeat_ms = now_ms + if ahead == 0 { PERIOD_MS } else { ahead };
         }
         Ok(frames)
     }

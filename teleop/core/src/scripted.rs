@@ -17,6 +17,8 @@ use crate::link::OperatorLink;
 
 /// Teleop traffic period, µs (50 Hz).
 pub const PERIOD_US: u64 = 20_000;
+/// The heartbeat goes out half a period after the command (as the interactive operator's).
+pub const HEARTBEAT_OFFSET_US: u64 = crate::operator::HEARTBEAT_OFFSET_MS * 1000;
 
 /// One step of a plan: from `at_us` on, command `mode`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -36,6 +38,7 @@ pub struct PlanStep {
 pub struct ScriptedTeleop {
     plan: Vec<PlanStep>,
     next_send_us: u64,
+    next_heartbeat_us: u64,
     link: OperatorLink,
     /// Whether a STOP of the arming phase went out.
     stop_sent: bool,
@@ -55,6 +58,7 @@ impl ScriptedTeleop {
         Self {
             plan,
             next_send_us: 0,
+            next_heartbeat_us: HEARTBEAT_OFFSET_US,
             link,
             stop_sent: false,
             armed: false,
@@ -80,13 +84,30 @@ impl ScriptedTeleop {
         self.plan.iter().rev().find(|s| s.at_us <= now_us)
     }
 
-    /// The frames to send at `now_us` (none between two 50 Hz slots).
+    /// The frames to send at `now_us`: the command in its 50 Hz slots, the heartbeat in slots
+    /// half a period later (as the interactive operator sends them).
     pub fn frames(&mut self, now_us: u64) -> Result<Vec<Frame>, EncodeError> {
-        if now_us < self.next_send_us {
-            return Ok(Vec::new());
-        }
-        self.next_send_us = now_us - now_us % PERIOD_US + PERIOD_US;
         let mut frames = Vec::with_capacity(2);
+        if now_us >= self.next_send_us {
+            self.next_send_us = now_us - now_us % PERIOD_US + PERIOD_US;
+            frames.extend(self.command(now_us)?);
+        }
+        if now_us >= self.next_heartbeat_us {
+            // The next time after now at the heartbeat's phase of the period.
+            let ahead = (HEARTBEAT_OFFSET_US + PERIOD_US - now_us % PERIOD_US) % PERIOD_US;
+            self.next_heartbeat_us = now_us + if ahead == 0 { PERIOD_US } else { ahead };
+            let uptime_ms = u32::try_from(now_us / 1000).unwrap_or(u32::MAX);
+            let heartbeat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
+                uptime: Millis::from_raw(uptime_ms).unwrap_or(Millis::saturating_from_si(0.0)),
+            });
+            frames.extend(self.link.seal(&heartbeat)?);
+        }
+        Ok(frames)
+    }
+
+    /// The command of the plan's step in force at `now_us` (STOP until armed).
+    fn command(&mut self, now_us: u64) -> Result<Option<Frame>, EncodeError> {
+        let mut sent = None;
         if let Some(step) = self.current(now_us).copied() {
             let mode = if self.armed {
                 step.mode
@@ -100,14 +121,9 @@ impl ScriptedTeleop {
             });
             if let Some(frame) = self.link.seal(&command)? {
                 self.stop_sent |= mode == TeleopMode::Stop;
-                frames.push(frame);
+                sent = Some(frame);
             }
         }
-        let uptime_ms = u32::try_from(now_us / 1000).unwrap_or(u32::MAX);
-        let heartbeat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
-            uptime: Millis::from_raw(uptime_ms).unwrap_or(Millis::saturating_from_si(0.0)),
-        });
-        frames.extend(self.link.seal(&heartbeat)?);
-        Ok(frames)
+        Ok(sent)
     }
 }
