@@ -13,7 +13,7 @@
 //! |-----------------|----------------------|--------------|-------------|-----------------------|
 //! | `0x000`         | [`EStop`]            | teleop, tool | emergency   | on event              |
 //! | `0x010`         | [`Sync`]             | simulator    | clock       | every cycle (lockstep only) |
-//! | `0x020`         | [`Announce`]         | controller   | session     | 10 Hz                 |
+//! | `0x020`         | [`Announce`]         | controller   | session     | 50 Hz                 |
 //! | `0x100`         | [`LegTargets`]       | controller   | command     | 250 Hz                |
 //! | `0x101`         | [`WheelCommand`]     | controller   | command     | every cycle           |
 //! | `0x180`–`0x183` | [`LegFeedback`] FL, FR, BL, BR | leg drives | feedback | 250 Hz          |
@@ -42,7 +42,11 @@
 //! let epoch = Epoch::new(7);
 //! let controller = Session::owned(TEST_KEY, epoch);
 //! let mut controller_rx = Receiver::owner(controller);
-//! let announce = AnyMessage::Announce(Announce { version: WireVersion::THIS, epoch });
+//! let announce = AnyMessage::Announce(Announce {
+//!     version: WireVersion::THIS,
+//!     epoch,
+//!     time: controller.time(),
+//! });
 //! let announce = Sender::new().seal(&controller, &announce).unwrap();
 //!
 //! // The teleop joins on the announcement, then sends an authenticated command.

@@ -2,7 +2,8 @@
 //! a frame to, in the manner of AUTOSAR SecOC's freshness value.
 //!
 //! The controller owns the session. At every start it takes an **epoch** strictly greater than
-//! any it used before (persisted: the MCU's backup register, firmware-host's state file) and
+//! any it used before (persisted: firmware-host's state file; the MCU image does not persist it
+//! yet, see `docs/mcu.md`, "Keys and epochs") and
 //! announces it with the wire version and its **session time** (ms since the session opened)
 //! ([`Announce`](crate::Announce), authenticated, at 50 Hz). Every other node joins by hearing
 //! the announcement and from then on binds each frame to the session: the frame's check value
@@ -26,8 +27,8 @@
 //! their check value, so that a node without the key cannot command the controller or release
 //! an E-stop; drive commands, feedback and status carry a CRC-32C, which guards against
 //! corruption and replay but not against a forger on the bus (see `docs/protocol.md`, "Threat
-//! model": in software on the Cortex-M4F an AES block costs about 6,000 instructions, too many
-//! for a 1 kHz drive command).
+//! model": a CMAC of both drive commands every tick would take the Cortex-M4F's control step
+//! past its instruction budget).
 //!
 //! One frame is bound to nothing: the E-stop **latch**, which anyone may send at any time with
 //! a fixed content (an E-stop panel's constant frame, an operator's `cansend`).

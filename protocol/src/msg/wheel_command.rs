@@ -8,9 +8,9 @@ use crate::units::Torque;
 
 /// Wheel torques, id `0x101`, controller → wheel drive. Zero torque leaves the wheels free.
 ///
-/// CRC-protected and bound to the session, not authenticated: a CMAC costs the Cortex-M4F
-/// about 6,000 instructions per AES block in software, which a 1 kHz command cannot carry
-/// within the control step's budget (see `docs/protocol.md`, "Threat model").
+/// CRC-protected and bound to the session, not authenticated: a CMAC of this frame and of the
+/// leg targets (one and three AES blocks) every tick would take the Cortex-M4F's control step
+/// past its instruction budget (see `docs/protocol.md`, "Threat model").
 ///
 /// | byte | field    | type    | meaning                            |
 /// |------|----------|---------|------------------------------------|

@@ -335,7 +335,7 @@ pub(super) fn estop(model: &Path, from: NodeId) -> Result<CellResult, SessionErr
     let source = if from == NodeId::Teleop {
         "teleop"
     } else {
-        "cansend (counter 0)"
+        "cansend (constant latch frame)"
     };
     let deadline_ms = SS1_TIMER_US as f64 * 1e-3;
     Ok(CellResult {
@@ -343,7 +343,7 @@ pub(super) fn estop(model: &Path, from: NodeId) -> Result<CellResult, SessionErr
         fault: format!("EStop latch at {latch_s} s, clear at {clear_s} s; L keeps coming"),
         expected: "EStop reported from the latch tick; a controlled stop, all drives torque-free by the SS1 deadline (2 s) and until the clear; no fall",
         measured: format!(
-            "EStop reported throughout: {reported}; all 5 drives torque-free {} after the latch, held until the clear: {held}; max tilt {:.1}°; driving again {}",
+            "EStop reported throughout: {reported}; all 5 drives torque-free {} after the latch, held until the clear: {held}; max tilt {:.1}°; drives powered again (holding, until STOP and a new command) {}",
             off_after_ms.map_or("never".into(), |ms| format!("{ms:.0} ms")),
             max_tilt_deg(latched),
             resumed.map_or("never".into(), |ms| format!("{ms:.0} ms after the clear"))
