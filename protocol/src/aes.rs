@@ -37,6 +37,8 @@ const fn xtime(b: u8) -> u8 {
     (b << 1) ^ if b & 0x80 != 0 { 0x1B } else { 0 }
 }
 
+// Indexing in const evaluation: out of bounds is a build error, not a panic.
+#[allow(clippy::indexing_slicing)]
 const fn sbox_table() -> [u8; 256] {
     let mut table = [0_u8; 256];
     // p runs over the multiplicative group by powers of 3, q over the inverses (powers of 3⁻¹).
@@ -44,9 +46,9 @@ const fn sbox_table() -> [u8; 256] {
     let mut q: u8 = 1;
     loop {
         p ^= xtime(p);
-        q ^= q << 1;
-        q ^= q << 2;
-        q ^= q << 4;
+        q ^= q << 1_u32;
+        q ^= q << 2_u32;
+        q ^= q << 4_u32;
         if q & 0x80 != 0 {
             q ^= 0x09;
         }
@@ -60,6 +62,7 @@ const fn sbox_table() -> [u8; 256] {
     table
 }
 
+#[allow(clippy::indexing_slicing)]
 const fn te_table() -> [u32; 256] {
     let mut table = [0_u32; 256];
     let mut x = 0;
@@ -67,7 +70,7 @@ const fn te_table() -> [u32; 256] {
         let s = SBOX[x];
         let s2 = xtime(s);
         let s3 = s2 ^ s;
-        table[x] = (s2 as u32) << 24 | (s as u32) << 16 | (s as u32) << 8 | s3 as u32;
+        table[x] = (s2 as u32) << 24_u32 | (s as u32) << 16_u32 | (s as u32) << 8_u32 | s3 as u32;
         x += 1;
     }
     table
@@ -153,7 +156,10 @@ impl Aes128 {
         let [k0, k1, k2, k3] = keys.next().unwrap_or_default();
         let [s0, s1, s2, s3] = s;
         let last = |a: u32, b: u32, c: u32, d: u32| {
-            sub(a >> 24) << 24 | sub(b >> 16) << 16 | sub(c >> 8) << 8 | sub(d)
+            sub(a >> 24_u32) << 24_u32
+                | sub(b >> 16_u32) << 16_u32
+                | sub(c >> 8_u32) << 8_u32
+                | sub(d)
         };
         let out = [
             last(s0, s1, s2, s3) ^ k0,

@@ -20,8 +20,8 @@ pub struct CmacKey {
 /// Doubling in GF(2^128) as CMAC defines it.
 fn double(block: &[u8; 16]) -> [u8; 16] {
     let value = u128::from_be_bytes(*block);
-    let carry = if value >> 127 == 1 { 0x87 } else { 0 };
-    ((value << 1) ^ carry).to_be_bytes()
+    let carry: u128 = if value >> 127_u32 == 1 { 0x87 } else { 0 };
+    ((value << 1_u32) ^ carry).to_be_bytes()
 }
 
 fn xor_into(block: &mut [u8; 16], other: &[u8; 16]) {

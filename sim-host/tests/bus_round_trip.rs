@@ -86,7 +86,7 @@ impl TestController {
             let announce = self.seal(AnyMessage::Announce(Announce {
                 version: WireVersion::THIS,
                 epoch: Epoch::new(1),
-                time: SessionTime::from_ms(self.services * 1000 / u32::from(HZ)),
+                time: SessionTime::from_ms(self.services * 1000 / HZ),
             }));
             self.bus.send(&announce).unwrap();
         }
