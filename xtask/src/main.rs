@@ -10,6 +10,7 @@ mod demo;
 mod elf;
 mod faults;
 mod firmware;
+mod frame;
 mod fuzz;
 mod hil;
 mod mujoco;
@@ -36,6 +37,11 @@ Tasks:
                      the vcan suite (`hil`)
   dbc [--check]      regenerate protocol/hybrid_robot.dbc (--check: fail if the committed file is stale)
   busload            print the per-cycle frame schedule and the bus load at 250 Hz and 1 kHz
+  frame KIND [opts]  a valid frame as a `cansend` line: `latch` (the constant E-stop latch),
+                     `release --epoch N --time-ms T --token N`, `command MODE --epoch N
+                     --time-ms T` (sealed with --key-file FILE, or the simulation's test key);
+                     epoch and time from the controller's latest Announce, the token from its
+                     status (`cargo xtask frame` alone prints the options)
   bench [args]       criterion benchmarks (control step, raw MuJoCo step, closed-loop cycle), then a
                      table of medians and steps per second, also written into docs/measurements.md
                      (args go to criterion, e.g. `--measurement-time 3`)
@@ -90,6 +96,7 @@ fn main() -> ExitCode {
         "demo" => demo::run(rest),
         "hil" => hil::run(rest),
         "firmware" => firmware::run(),
+        "frame" => frame::run(rest),
         "pil" => pil::run(rest),
         "fuzz" => fuzz::run(rest),
         "faults" => faults::run(rest),
