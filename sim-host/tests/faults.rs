@@ -26,6 +26,9 @@ fn every_cell_of_the_fault_matrix_holds() {
         "simulator restarted",
         "E-stop from teleop",
         "E-stop from cansend",
+        "E-stop release replayed",
+        "forged operator commands",
+        "controller restarted",
     ] {
         assert!(
             cells.iter().any(|c| c.name.contains(needed)),

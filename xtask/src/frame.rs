@@ -67,14 +67,17 @@ fn compose(request: &Request, key: Key) -> Result<Frame, String> {
         return protocol::classic_latch(request.source, 0)
             .ok_or_else(|| "the classic latch could not be encoded".to_string());
     }
-    request.message.encode(&session, counter).map_err(|e| match e {
-        protocol::EncodeError::NoSession => {
-            "this frame is bound to the controller's session: give --epoch and --time-ms (from \
+    request
+        .message
+        .encode(&session, counter)
+        .map_err(|e| match e {
+            protocol::EncodeError::NoSession => {
+                "this frame is bound to the controller's session: give --epoch and --time-ms (from \
              its latest Announce, id 0x020)"
-                .to_string()
-        }
-        other => format!("the frame could not be encoded: {other:?}"),
-    })
+                    .to_string()
+            }
+            other => format!("the frame could not be encoded: {other:?}"),
+        })
 }
 
 /// `cansend`'s text for `frame`: `ID#DATA` for a classic frame (up to 8 bytes, the classic

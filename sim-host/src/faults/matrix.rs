@@ -17,6 +17,7 @@ use crate::faults::cells::{
 };
 use crate::faults::judge::{fell, forward_m, max_tilt_deg};
 use crate::faults::rig::Rig;
+use crate::faults::security::{forged_commands, release_replayed, restart_interlock};
 use crate::session::SessionError;
 
 /// One judged cell.
@@ -172,6 +173,9 @@ pub fn run(model: &Path) -> Result<Vec<CellResult>, SessionError> {
     cells.push(firmware_killed(model)?);
     cells.push(simulator_restarted(model)?);
     cells.extend(estop_cells(model)?);
+    cells.push(release_replayed(model)?);
+    cells.push(forged_commands(model)?);
+    cells.push(restart_interlock(model)?);
     Ok(cells)
 }
 

@@ -6,3 +6,4 @@ mod cells;
 mod judge;
 pub mod matrix;
 pub mod rig;
+mod security;

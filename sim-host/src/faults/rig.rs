@@ -86,6 +86,7 @@ pub struct Rig {
     teleop: ScriptedTeleop,
     teleop_bus: FaultyBus<InprocEndpoint>,
     tool: InprocEndpoint,
+    bus: InprocBus,
     recorder: Recorder,
     stats: RunStats,
     time_us: u64,
@@ -116,6 +117,7 @@ impl Rig {
         let teleop_bus = FaultyBus::new(bus.endpoint(), teleop_faults);
         let tool = bus.transmitter();
         Ok(Self {
+            bus,
             model: model.to_owned(),
             sim,
             sim_bus,
@@ -133,12 +135,27 @@ impl Rig {
     }
 
     /// A release of the controller's present latch from `from`, sealed with the key as a
-    /// keyholder's tool (`cargo xtask frame`) would; `None` once the controller is gone.
+    /// keyholder's tool (`cargo xtask frame`) would, its counter the session time; `None` once
+    /// the controller is gone.
     pub fn release_frame(&self, from: protocol::NodeId) -> Option<Frame> {
         let node = self.controller.as_ref()?.node();
         let release =
             protocol::AnyMessage::EStop(protocol::EStop::release(from, node.release_token()));
-        release.encode(node.session(), 1).ok()
+        let session = node.session();
+        release.encode(session, session.time().ms()).ok()
+    }
+
+    /// Restarts the firmware as a new process would: a new node opening session `epoch` on the
+    /// same bus (its latch, if the old one had one, is not carried over: a board that persists
+    /// it restores it itself).
+    pub fn restart_firmware(&mut self, epoch: Epoch) -> Result<(), SessionError> {
+        let firmware = firmware_config(RIG_HZ).ok_or(SessionError::ControlRate(RIG_HZ))?;
+        let session = Session::owned(TEST_KEY, epoch);
+        self.controller = Some(
+            InprocController::new(firmware, self.bus.endpoint(), session)
+                .map_err(SessionError::Firmware)?,
+        );
+        Ok(())
     }
 
     /// Runs one control cycle.

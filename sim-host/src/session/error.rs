@@ -28,6 +28,9 @@ pub enum SessionError {
     /// The firmware's configuration was rejected.
     #[error("the firmware rejected its configuration: {0:?}")]
     Firmware(firmware::control::controller::ConfigError),
+    /// A fault cell could not set up its scenario (a bug in the cell).
+    #[error("a fault cell could not set up {0} (a bug in the fault matrix)")]
+    Internal(&'static str),
     /// Rendering frames.
     #[cfg(feature = "renderer")]
     #[error(transparent)]
