@@ -209,7 +209,8 @@ impl E2eStatus {
 /// A sender's counters stay within [`MAX_LAG_MS`] below the session time (see
 /// [`crate::session`]), so a sender that restarted, a receiver that joined late, and a
 /// sequence with a gap of 2^15 frames or more are found at the first candidate, while a replay
-/// (at or behind the last accepted counter, or older than the candidates reach: about 97 s) is
+/// (at or behind the last accepted counter, or older than the candidates reach: 2^15 + 2^16 ms,
+/// 98.3 s) is
 /// not.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Search {

@@ -17,18 +17,19 @@ fn now_for(checker: &E2eChecker, sent: u32) -> u32 {
 
 /// Offers `checker` a frame of a genuine sender whose full counter is `sent`: its check value
 /// holds at that counter and at no other, as a check that covers the full counter does. The
-/// receiver searches as the controller does for a CMAC (the fewest tries).
+/// receiver searches as every receiver does (two candidates).
 fn offer(checker: &mut E2eChecker, sent: u32) -> E2eStatus {
-    let search = Search::new(Check::Mac, true, now_for(checker, sent));
+    let search = Search::new(now_for(checker, sent));
     checker.check(sent as u16, search, |full| full == sent)
 }
 
 /// Offers `checker` a frame whose check holds at no counter: corrupted, forged, or from
-/// another session. The receiver searches as widely as any does.
+/// another session. The receiver searches far wider than any does: every period of 2^16 from
+/// the top of the counter range down.
 fn offer_forged(checker: &mut E2eChecker, low: u16) -> E2eStatus {
     let search = Search {
-        reference: u32::MAX,
-        tries: 1 << 12,
+        reference: 0xFFFF_0000,
+        tries: 1 << 16,
     };
     checker.check(low, search, |_| false)
 }
@@ -65,7 +66,7 @@ fn a_gap_is_ok_some_lost() {
 /// of the time) is a sender that restarted at the session time, not a loss.
 #[test]
 fn a_jump_past_the_elapsed_time_is_a_restart_not_a_loss() {
-    let at = |reference| Search::new(Check::Mac, true, reference);
+    let at = Search::new;
     let mut checker = E2eChecker::new();
     let mut offer_at = |sent: u32, now: u32| checker.check(sent as u16, at(now), |f| f == sent);
     assert_eq!(offer_at(1_000, 1_000), E2eStatus::Initial);
@@ -167,45 +168,93 @@ fn the_counter_wraps_into_the_high_half() {
     assert_eq!(checker.last(), Some(0x1_0001));
 }
 
+/// The full counter a receiver at session time `reference` tries first for low half `low`: the
+/// one within 2^15 of `reference`, and at exactly 2^15 on either side the one in the same period
+/// of 2^16 as `reference`. Negative when the nearest would be below zero (no such counter).
+fn nearest(reference: u32, low: u16) -> i64 {
+    let lowest = i64::from(reference)
+        - if reference & 0xFFFF < 0x8000 {
+            0x7FFF
+        } else {
+            0x8000
+        };
+    lowest + (i64::from(low) - lowest).rem_euclid(0x1_0000)
+}
+
+/// Whether a receiver at session time `reference` finds `counter` among the `tries` candidates
+/// of its search: the nearest, then periods of 2^16 below it.
+fn among_candidates(reference: u32, tries: u32, counter: u32) -> bool {
+    let first = nearest(reference, counter as u16);
+    let counter = i64::from(counter);
+    counter <= first && (first - counter) >> 16 < i64::from(tries)
+}
+
+/// Every receiver makes the same search, whatever the check and whoever it is: two candidates,
+/// the counter with the frame's low half nearest its session time, then the one 2^16 below:
+/// 2^15 ahead of its time to 2^15 + 2^16 behind it.
 #[test]
-fn a_first_frame_is_looked_for_in_as_many_high_halves_as_allowed() {
-    // From the half after the receiver's time's (5 + 1) downward.
-    let sent = 3 << 16 | 7;
-    let now = 5 << 16 | 0x1234;
-    let mut checker = E2eChecker::new();
-    let search = |tries| Search {
-        reference: now,
-        tries,
+fn a_first_frame_is_looked_for_nearest_the_receivers_time_then_one_period_below() {
+    let first = |sent: u32, search: Search| {
+        let mut checker = E2eChecker::new();
+        let status = checker.check(sent as u16, search, |full| full == sent);
+        let accepted = status.is_accepted();
+        assert_eq!(checker.last(), accepted.then_some(sent), "{sent:#x}");
+        assert!(matches!(
+            status,
+            E2eStatus::Initial | E2eStatus::CheckFailed
+        ));
+        accepted
     };
-    assert_eq!(
-        checker.check(7, search(3), |full| full == sent),
-        E2eStatus::CheckFailed
-    );
-    assert_eq!(checker.last(), None);
-    assert_eq!(
-        checker.check(7, search(4), |full| full == sent),
-        E2eStatus::Initial
-    );
-    assert_eq!(checker.last(), Some(sent));
-    // A counter more than one half past the receiver's time is not looked for.
-    let mut checker = E2eChecker::new();
-    let early = Search {
-        reference: 1 << 16,
-        tries: 1 << 12,
-    };
-    assert_eq!(
-        checker.check(7, early, |full| full == sent),
-        E2eStatus::CheckFailed
-    );
-    assert_eq!(Search::new(Check::Crc, false, now).tries, 1 << 12);
-    assert_eq!(Search::new(Check::Crc, true, now).tries, 1 << 12);
-    assert_eq!(Search::new(Check::Mac, false, now).tries, 1 << 8);
-    assert_eq!(
-        Search::new(Check::Mac, true, now).tries,
-        2,
-        "the controller spends at most two CMACs looking"
-    );
-    assert_eq!(Search::new(Check::Mac, true, now).reference, now);
+    for now in [5 << 16 | 0x1234, 5 << 16 | 0x9234] {
+        let search = |tries| Search {
+            reference: now,
+            tries,
+        };
+        assert_eq!(Search::new(now), search(2));
+        // The tie at 2^15 goes to the counter in the period of `now`.
+        let (behind, ahead) = if now & 0xFFFF < 0x8000 {
+            (0x7FFF, 0x8000)
+        } else {
+            (0x8000, 0x7FFF)
+        };
+        // The nearest, found at the first try.
+        for sent in [now, now - 1, now + 1, now - behind, now + ahead] {
+            assert!(first(sent, search(1)), "{now:#x} {sent:#x}");
+        }
+        // One period below it: the second try.
+        for sent in [now - behind - 1, now - 0x1_0000, now - behind - 0x1_0000] {
+            assert!(!first(sent, search(1)), "{now:#x} {sent:#x}");
+            assert!(first(sent, search(2)), "{now:#x} {sent:#x}");
+            assert!(first(sent, Search::new(now)), "{now:#x} {sent:#x}");
+        }
+        // Further below: not with two tries, with more.
+        for (sent, tries) in [
+            (now - behind - 0x1_0001, 3),
+            (now - 0x2_0000, 3),
+            (now - 0x3_0000, 4),
+            (now & 0xFFFF, 6),
+        ] {
+            assert!(!first(sent, Search::new(now)), "{now:#x} {sent:#x}");
+            assert!(!first(sent, search(tries - 1)), "{now:#x} {sent:#x}");
+            assert!(first(sent, search(tries)), "{now:#x} {sent:#x}");
+        }
+        // Past the nearest ahead: never, however many tries.
+        for sent in [now + ahead + 1, now + 0x1_0000, now + 0x10_0000] {
+            assert!(!first(sent, search(1 << 16)), "{now:#x} {sent:#x}");
+        }
+        assert!(!first(now, search(0)), "no tries, no search");
+    }
+    // Near zero there are no candidates below it: a low half whose nearest would be negative
+    // is not looked for at all.
+    assert!(!first(0x9000, Search::new(10)));
+    assert!(first(0x8000, Search::new(0)));
+    assert!(first(0x7000, Search::new(10)));
+    // A teleop that joined on an announcement just below a boundary of 2^16 ms, its first frame
+    // received by the controller just past it. (Wire version 2 first looked from the period
+    // after the receiver's time's downward, the controller two periods: 2^17 + 65 500 and
+    // 2^16 + 65 500, never 65 500 itself.)
+    assert!(first(65_500, Search::new(65_540)));
+    assert_eq!(nearest(65_540, 65_500_u32 as u16), 65_500);
 }
 
 #[test]
@@ -223,7 +272,7 @@ fn half_the_counter_range_ahead_is_found_by_the_search() {
     // A receiver whose time is more than a half behind the frame does not find it.
     let mut checker = checker_after(&[10]);
     let sent = 10 + 0x2_8000;
-    let behind = Search::new(Check::Mac, true, 10);
+    let behind = Search::new(10);
     assert_eq!(
         checker.check(sent as u16, behind, |full| full == sent),
         E2eStatus::CheckFailed
@@ -236,76 +285,88 @@ fn half_the_counter_range_ahead_is_found_by_the_search() {
 }
 
 /// The search never goes back to or behind the last accepted counter: a frame one or more
-/// halves old with the low half of a counter ahead is not found, however many halves are
-/// tried.
+/// periods of 2^16 old with the low half of a counter ahead is not found, however many periods
+/// are tried and wherever the receiver's time is.
 #[test]
 fn the_search_never_finds_a_counter_at_or_behind_the_last_accepted() {
     let last = 9 << 16 | 0x0100;
     for sent in [last, last - 1, 8 << 16 | 0x0200, 3 << 16 | 0x0100, 0x0100] {
-        let mut checker = checker_after(&[last]);
-        let search = Search {
-            reference: u32::MAX,
-            tries: 1 << 16,
-        };
-        let status = checker.check(sent as u16, search, |full| full == sent);
-        assert!(!status.is_accepted(), "{sent:#x}: {status:?}");
-        assert_eq!(checker.last(), Some(last));
+        for reference in [sent, last, last + 0x8000, last + 0x1_0000, 0x7FFF_0000] {
+            let mut checker = checker_after(&[last]);
+            let search = Search {
+                reference,
+                tries: 1 << 16,
+            };
+            assert!(
+                among_candidates(reference, 1 << 16, sent),
+                "reached but for the last"
+            );
+            let status = checker.check(sent as u16, search, |full| full == sent);
+            assert!(!status.is_accepted(), "{sent:#x}: {status:?}");
+            assert_eq!(checker.last(), Some(last));
+        }
     }
 }
 
-/// A CMAC costs a block cipher run per try: a frame forged without the key costs the
-/// controller one try where the sequence places it and at most two in the search.
+/// A CMAC costs a block cipher run per try: a frame forged without the key costs any receiver,
+/// the controller or a member, one try where the sequence places it and at most two in the
+/// search, within the budget of 1 + 1 + 2. The search skips candidates at or behind the last
+/// accepted counter without a try, so with a recent sequence it costs at most one; both tries
+/// are spent only with no sequence or one last heard more than 2^15 + 2^16 ms ago. (Wire
+/// version 2 first let a member look through 2^8 periods for a CMAC frame: up to 1 + 256 runs
+/// per forged frame.)
 #[test]
-fn a_forged_cmac_costs_the_controller_at_most_four_verifications() {
+fn a_forged_cmac_costs_at_most_one_verification_in_the_sequence_and_two_in_the_search() {
     let epoch = Some(Epoch::new(12));
     let data_id = 0xC200;
     let forger = Key([0x66; 16]);
     let payload = *b"drive!";
-    let now = 7 << 16 | 0x4000;
-    let genuine: Vec<u32> = (now - 40..now - 20).collect();
     let mut worst = 0;
-    for fresh in [true, false] {
-        for counter in [
-            0,
-            1,
-            now - 21,
-            now - 20,
-            now - 19,
-            now - 30,
-            now,
-            now + 0x8000,
-            !0,
-        ] {
-            let mut checker = if fresh {
-                E2eChecker::new()
-            } else {
-                checker_after(&genuine)
-            };
-            let before = checker.last();
-            let freshness = Freshness {
-                data_id,
-                epoch,
-                counter,
-            };
-            let message = protected(Check::Mac, &forger, &freshness, &payload);
-            let (sent, low) = header(&message).unwrap();
-            let mut runs = 0;
-            let status = checker.check(low, Search::new(Check::Mac, true, now), |counter| {
-                runs += 1;
-                let at = Freshness {
+    for now in [7 << 16 | 0x4000, 7 << 16 | 0xC000, 65_540, 100] {
+        let recent: Vec<u32> = (now - 40..now - 20).collect();
+        let stale: Vec<u32> = (now.saturating_sub(0x4_0000)..).take(20).collect();
+        for (history, most) in [(&[][..], 2), (&recent[..], 1 + 1), (&stale[..], 1 + 2)] {
+            for counter in [
+                0,
+                1,
+                now - 21,
+                now - 20,
+                now - 19,
+                now - 30,
+                now,
+                now - 0x8000.min(now),
+                now - 0x1_0000.min(now),
+                now + 0x8000,
+                !0,
+            ] {
+                let mut checker = checker_after(history);
+                let before = checker.last();
+                let freshness = Freshness {
                     data_id,
                     epoch,
                     counter,
                 };
-                check_value(Check::Mac, &TEST_KEY, &at, &payload) == sent
-            });
-            assert_eq!(status, E2eStatus::CheckFailed, "{counter:#x}");
-            assert_eq!(checker.last(), before);
-            assert!(runs <= 1 + 1 + 2, "{counter:#x}: {runs} CMACs");
-            if fresh {
-                assert!(runs <= 2, "no sequence: the search alone, {runs} CMACs");
+                let message = protected(Check::Mac, &forger, &freshness, &payload);
+                let (sent, low) = header(&message).unwrap();
+                let mut runs = 0;
+                let status = checker.check(low, Search::new(now), |counter| {
+                    runs += 1;
+                    let at = Freshness {
+                        data_id,
+                        epoch,
+                        counter,
+                    };
+                    check_value(Check::Mac, &TEST_KEY, &at, &payload) == sent
+                });
+                assert_eq!(status, E2eStatus::CheckFailed, "{counter:#x}");
+                assert_eq!(checker.last(), before);
+                assert!(runs <= 1 + 1 + 2, "{counter:#x}: {runs} CMACs");
+                assert!(
+                    runs <= most,
+                    "{now:#x} {counter:#x} {history:?}: {runs} CMACs"
+                );
+                worst = worst.max(runs);
             }
-            worst = worst.max(runs);
         }
     }
     assert_eq!(worst, 3, "one try in the sequence, two in the search");
@@ -346,7 +407,7 @@ fn receive_bytes(
     message: &[u8],
 ) -> E2eStatus {
     let (sent, low) = header(message).unwrap();
-    checker.check(low, Search::new(check, false, 0), |counter| {
+    checker.check(low, Search::new(0), |counter| {
         let freshness = Freshness {
             data_id,
             epoch,
@@ -657,9 +718,9 @@ proptest! {
         prop_assert_eq!(offer(&mut checker, last + ahead + 1), E2eStatus::Ok);
     }
 
-    /// The same frame, at a receiver whose time is `now`: found exactly when its high half is
-    /// among the controller's two tries (the half of `now` and the next); refused otherwise,
-    /// and the sequence unchanged.
+    /// The same frame, at a receiver whose time is `now`: found exactly when it is one of the
+    /// two candidates of the search (2^15 ahead of `now` to 2^15 + 2^16 behind it); refused
+    /// otherwise, and the sequence unchanged.
     #[test]
     fn a_frame_half_the_range_or_more_ahead_is_found_only_near_the_receivers_time(
         (start, gaps) in history(),
@@ -669,9 +730,15 @@ proptest! {
         let (mut checker, last) = replay_history(start, &gaps);
         let sent = last + ahead;
         let now = (last + lead).min(sent + 0x2_0000);
-        let status = checker.check(sent as u16, Search::new(Check::Mac, true, now), |full| full == sent);
-        let near = sent >> 16 == now >> 16 || sent >> 16 == (now >> 16) + 1;
-        if near {
+        let status = checker.check(sent as u16, Search::new(now), |full| full == sent);
+        let distance = i64::from(sent) - i64::from(now);
+        prop_assert_eq!(
+            among_candidates(now, 2, sent),
+            (-0x1_8000..=0x8000).contains(&distance)
+                && !(distance == 0x8000 && now & 0xFFFF >= 0x8000)
+                && !(distance == -0x1_8000 && now & 0xFFFF < 0x8000)
+        );
+        if among_candidates(now, 2, sent) {
             prop_assert_eq!(status, E2eStatus::Initial);
             prop_assert_eq!(checker.last(), Some(sent));
         } else {
@@ -699,8 +766,8 @@ proptest! {
         prop_assert_eq!(checker.last(), Some(last));
     }
 
-    /// A first frame is found exactly when its high half is among those tried: the half after
-    /// the receiver's time's and the `tries − 1` below it.
+    /// A first frame is found exactly when it is among the `tries` candidates: the counter with
+    /// its low half nearest the receiver's time, and the `tries − 1` periods of 2^16 below it.
     #[test]
     fn a_first_frame_is_found_within_its_tries(
         sent in 0_u32..(600 << 16),
@@ -710,9 +777,7 @@ proptest! {
         let mut checker = E2eChecker::new();
         let search = Search { reference, tries };
         let status = checker.check(sent as u16, search, |full| full == sent);
-        let first = (reference >> 16) + 1;
-        let high = sent >> 16;
-        if high <= first && first - high < tries {
+        if among_candidates(reference, tries, sent) {
             prop_assert_eq!(status, E2eStatus::Initial);
             prop_assert_eq!(checker.last(), Some(sent));
         } else {

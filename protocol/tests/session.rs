@@ -8,7 +8,7 @@ use std::sync::OnceLock;
 
 use common::{announce_frame, announce_frame_at, joined_member, member_at, owner_at};
 use proptest::prelude::*;
-use protocol::e2e::HEADER_LEN;
+use protocol::e2e::{HEADER_LEN, MAX_LAG_MS};
 use protocol::*;
 
 // ------------------------------------------------------------------------------------------
@@ -179,12 +179,13 @@ impl Bus {
         let frame = node.tx.seal(&session, &message).unwrap();
         let epoch = session.epoch();
         // A sender's counters all start at the session time of its first frame in the session
-        // and count one per frame on each identifier; the E-stop's never falls behind the time.
+        // and count one per frame on each identifier; the E-stop's never falls behind the time,
+        // and any other jumps to the time once it is more than `MAX_LAG_MS` behind it.
         let now = session.time().ms();
         let start = *node.start.get_or_insert(now);
         let slot = &mut self.next[message.id().index()];
         let mut counter = slot.unwrap_or(start);
-        if message.id() == MessageId::EStop {
+        if message.id() == MessageId::EStop || counter + MAX_LAG_MS < now {
             counter = counter.max(now);
         }
         *slot = Some(counter + 1);
@@ -511,6 +512,26 @@ fn the_recorded_run_wraps_the_counter_and_carries_every_kind_of_frame() {
     let latches = log.iter().filter(|l| l.is_latch()).count();
     assert_eq!(latches, 14, "7 sealed and 7 classic");
     assert_eq!(on(MessageId::EStop), 21, "and 7 releases");
+    // The identifiers slower than one frame a millisecond fell `MAX_LAG_MS` behind the session
+    // time and jumped to it, again and again; the 1 kHz ones never did.
+    let jumps = |id: MessageId| {
+        let counters: Vec<u32> = log
+            .iter()
+            .filter(|l| l.id() == id)
+            .map(|l| l.counter)
+            .collect();
+        counters.windows(2).filter(|w| w[1] != w[0] + 1).count()
+    };
+    for id in [
+        MessageId::LegTargets,
+        MessageId::TeleopHeartbeat,
+        MessageId::ControllerStatus,
+        MessageId::TeleopCommand,
+    ] {
+        assert!(jumps(id) >= 2, "{id:?}: {}", jumps(id));
+    }
+    assert_eq!(jumps(MessageId::WheelCommand), 0);
+    assert_eq!(jumps(MessageId::WheelFeedback), 0);
 }
 
 #[test]
@@ -538,7 +559,8 @@ fn the_whole_log_replayed_in_a_new_session_is_refused_but_for_the_latches() {
     let mut bus = recorded.next_session.clone();
     // Every node hears every frame of the old session: the one that joined last (no sequence
     // on any identifier) and each node its own identifiers too, which it has no sequence on.
-    // A receiver with no sequence looks only in the halves of its session time, which is short.
+    // A receiver with no sequence looks only near its session time (300 ms into the new
+    // session): the old session's frames fail their check there, and everywhere else.
     let tally = replay(&mut bus, &recorded.log, expected_next_session);
     for cause in [
         RejectCause::Crc,
@@ -1240,9 +1262,9 @@ fn the_longest_burst_in_sequence_is_just_under_half_the_counter_range() {
         E2eStatus::OkSomeLost { lost: 0x7FFE }
     );
     assert_eq!(member.counters().lost.raw(), 0x7FFE);
-    // 2^15 − 1 lost: the frame reads as behind, where its check fails; the search in the
-    // halves of the member's time finds it and the sequence starts again there. The loss is
-    // not counted: the receiver cannot tell how many halves it skipped.
+    // 2^15 − 1 lost: the frame reads as behind, where its check fails; the search near the
+    // member's time finds it and the sequence starts again there. The loss is not counted:
+    // the receiver cannot tell how many periods of 2^16 it skipped.
     let mut member = member_at(OLD, 100);
     receive(&mut member, &wheel_command(100, OLD)).unwrap();
     heard(&mut member, 100 + 0x8000 - 10);
@@ -1504,7 +1526,7 @@ fn a_member_that_joins_after_the_counter_wrapped_takes_the_next_frame() {
 
 /// Wire version 2 first could not place a frame 2^15 or more ahead of the last it accepted:
 /// after such a gap a receiver refused the sender for the rest of the session. Now the frame is
-/// found in the halves of the receiver's session time.
+/// found by the search, nearest the receiver's session time.
 #[test]
 fn a_gap_of_40_000_lost_frames_is_recovered() {
     let mut clock = Clock::new(1_000);
@@ -1563,10 +1585,17 @@ fn a_gap_of_40_000_lost_frames_is_recovered() {
 }
 
 /// A member that has just joined has no sequence to hold a frame against: it takes the first
-/// genuine frame it finds in the halves of its session time, and so takes a frame replayed from
-/// earlier in the session if its counter is in those halves. Further back it is refused: a
-/// CMAC frame recorded more than 2^16 · 2^8 ms (4.66 h) earlier, a CRC frame more than
-/// 2^16 · 2^12 ms (74.6 h) earlier.
+/// genuine frame its search finds, and so takes a frame replayed from earlier in the session if
+/// its counter is one of the search's two candidates: the counter with the frame's low half
+/// nearest the member's session time (within ±2^15 ms), and the one 2^16 below that. So a
+/// replay is taken back to 2^15 + 2^16 ms (98.3 s) before the member's time and refused from
+/// further back, CMAC and CRC alike; which end of the window is closed depends on the low half
+/// of the member's time (the candidate 2^15 away on either side is the one in the same period of
+/// 2^16). Every genuine sender is well inside: its counter is at most `MAX_LAG_MS` (16.4 s)
+/// behind the session time.
+///
+/// Wire version 2 first looked through 2^8 periods of 2^16 ms for a CMAC (4.66 h) and 2^12 for
+/// a CRC (74.6 h): a frame recorded two minutes or an hour before was taken.
 #[test]
 fn a_freshly_joined_member_refuses_a_replay_from_beyond_its_search() {
     let sync = |counter: u32| {
@@ -1586,42 +1615,303 @@ fn a_freshly_joined_member_refuses_a_replay_from_beyond_its_search() {
         .unwrap()
     };
     type Seal = fn(u32) -> Frame;
-    let cases: [(Seal, u32, DecodeError); 2] = [
-        (command, 1 << 8, DecodeError::Unauthentic { id: 0x200 }),
-        (sync, 1 << 12, DecodeError::CrcMismatch { id: 0x010 }),
+    let cases: [(Seal, DecodeError); 2] = [
+        (command, DecodeError::Unauthentic { id: 0x200 }),
+        (sync, DecodeError::CrcMismatch { id: 0x010 }),
     ];
-    for (seal, tries, check_failed) in cases {
-        // The member joins at `now`; the sender's counter then is about `now`.
-        let now = (tries + 44) << 16 | 0x1234;
-        // The lowest half it looks in is `tries − 1` below the one after its time's.
-        let lowest = (now >> 16) + 1 - (tries - 1);
-        for (recorded, taken) in [
-            (now - (tries << 16), false),
-            (now - (tries << 16) - 1, false),
-            (now - 0x4000_0000_u32.min(now), false),
-            ((lowest << 16) - 1, false),
-            (lowest << 16, true),
-            (now - ((tries - 2) << 16), true),
-            (now - 60_000, true),
-        ] {
-            let mut member = member_at(OLD, now);
-            let got = receive(&mut member, &seal(recorded));
-            if taken {
-                assert_eq!(got.unwrap().status, E2eStatus::Initial, "{recorded}");
+    const WINDOW: u32 = 0x8000 + 0x1_0000;
+    assert_eq!(WINDOW, 98_304);
+    for (seal, check_failed) in cases {
+        // The member joins at `now`, 5.5 h into the session, low half below or above 2^15.
+        for now in [300 << 16 | 0x1234, 300 << 16 | 0x9234] {
+            // The oldest counter its search reaches.
+            let oldest = if now & 0xFFFF < 0x8000 {
+                now - WINDOW + 1
             } else {
-                assert_eq!(got, Err(check_failed), "{recorded}");
+                now - WINDOW
+            };
+            for (recorded, taken) in [
+                (now, true),
+                (now - 10, true),
+                (now - MAX_LAG_MS, true),
+                (now - 0x8000, true),
+                (now - 60_000, true),
+                (oldest, true),
+                (oldest - 1, false),
+                (now - 0x2_0000, false),
+                (now - 120_000, false),
+                (now - 3_600_000, false),
+                (now - (1 << 24), false),
+                (now - ((1 << 12) << 16).min(now), false),
+            ] {
+                let mut member = member_at(OLD, now);
+                let got = receive(&mut member, &seal(recorded));
+                if taken {
+                    assert_eq!(got.unwrap().status, E2eStatus::Initial, "{now} {recorded}");
+                } else {
+                    assert_eq!(got, Err(check_failed), "{now} {recorded}");
+                }
+                // Either way the genuine sender's next frame is taken, and the replay is then
+                // behind it.
+                let genuine = now + 10;
+                assert!(receive(&mut member, &seal(genuine))
+                    .unwrap()
+                    .status
+                    .is_accepted());
+                assert!(receive(&mut member, &seal(recorded)).is_err());
             }
-            // Either way the genuine sender's next frame is taken, and the replay is then
-            // behind it.
-            let genuine = now + 10;
-            assert!(receive(&mut member, &seal(genuine))
-                .unwrap()
-                .status
-                .is_accepted());
-            assert!(receive(&mut member, &seal(recorded)).is_err());
         }
-        assert!(now - (lowest << 16) < tries << 16);
     }
+}
+
+/// Wire version 2 first looked for a first frame from the period of 2^16 ms after the
+/// receiver's time's downward, the controller in two periods: a teleop that joined on an
+/// announcement just below a boundary (65 500 ms) sealed its first frames there, while the
+/// controller's time had passed the boundary (65 540 ms), so the controller refused it until
+/// its counter passed 65 536. Now every receiver looks first at the counter nearest its time.
+#[test]
+fn a_teleop_joining_just_below_a_period_boundary_is_taken_from_its_first_frame() {
+    let mut controller = owner_at(OLD, 65_540);
+    let mut drive = member_at(OLD, 65_540);
+    let teleop = member_at(OLD, 65_500);
+    let mut tx = Sender::new();
+    let command = AnyMessage::TeleopCommand(TeleopCommand {
+        mode: TeleopMode::WheelForward,
+        body_height: BodyHeight::default(),
+        speed_scale: SpeedScale::from_raw(50).unwrap(),
+    });
+    for (message, status) in [
+        (heartbeat(1), E2eStatus::Initial),
+        (command, E2eStatus::Initial),
+        (heartbeat(2), E2eStatus::Ok),
+        (command, E2eStatus::Ok),
+    ] {
+        let frame = tx.seal(teleop.session(), &message).unwrap();
+        let counter = decode_frame(frame.id(), frame.data()).unwrap().counter;
+        assert!((65_500..65_502).contains(&u32::from(counter)), "{counter}");
+        for rx in [&mut controller, &mut drive] {
+            let accepted = receive(rx, &frame).unwrap();
+            assert_eq!(accepted.message, message);
+            assert_eq!(accepted.status, status, "{message:?}");
+        }
+    }
+    assert_eq!(*controller.counters(), *drive.counters());
+    assert_eq!(controller.counters().total(), 0);
+    assert_eq!(controller.counters().lost.raw(), 0);
+}
+
+/// The counter a sender slower than one frame a millisecond uses for its `k`-th frame on an
+/// identifier, sealed at session time `times[k]`: from the time of its first frame, one per
+/// frame, and the session time itself once the next would be more than `MAX_LAG_MS` behind.
+fn slow_sender_counters(times: &[u32]) -> Vec<u32> {
+    let mut next = times[0];
+    times
+        .iter()
+        .map(|&now| {
+            if next + MAX_LAG_MS < now {
+                next = now;
+            }
+            next += 1;
+            next - 1
+        })
+        .collect()
+}
+
+/// Wire version 2 first let a slow sender's counter fall ever further behind the session time:
+/// after a long gap in its frames (here 15 minutes) the controller, which looks near its own
+/// time, never found it again. Now its counter stays within `MAX_LAG_MS` of the session time,
+/// and the first frame after the gap restarts the sequence.
+#[test]
+fn a_50_hz_sender_is_taken_again_at_its_first_frame_after_15_minutes_lost() {
+    let mut clock = Clock::new(1_000);
+    let mut controller = owner_at(OLD, 1_000);
+    let mut drive = member_at(OLD, 1_000);
+    let mut teleop = member_at(OLD, 1_000);
+    let mut tx = Sender::new();
+    let lost = 61_000..61_000 + 15 * 60_000;
+    let times: Vec<u32> = (1_000..lost.end + 100).step_by(20).collect();
+    let expected = slow_sender_counters(&times);
+    let mut after_gap = Vec::new();
+    for (&ms, &counter) in times.iter().zip(&expected) {
+        clock.to(ms, &mut controller, &mut [&mut drive, &mut teleop]);
+        let frame = tx.seal(teleop.session(), &heartbeat(ms)).unwrap();
+        let decoded = decode_frame(frame.id(), frame.data()).unwrap();
+        assert_eq!(decoded.counter, counter as u16, "{ms}");
+        assert!(ms - counter <= MAX_LAG_MS + 1, "{ms}: {counter}");
+        if lost.contains(&ms) {
+            continue;
+        }
+        let statuses = [&mut controller, &mut drive].map(|rx| receive(rx, &frame).unwrap().status);
+        assert_eq!(statuses[0], statuses[1], "{ms}");
+        if ms >= lost.end {
+            after_gap.push(statuses[0]);
+        }
+    }
+    assert_eq!(after_gap[..2], [E2eStatus::Initial, E2eStatus::Ok]);
+    assert!(after_gap[1..].iter().all(|s| *s == E2eStatus::Ok));
+    for rx in [&controller, &drive] {
+        assert_eq!(rx.counters().total(), 0);
+        // A gap the sequence cannot span restarts it: the frames in it are not counted.
+        assert_eq!(rx.counters().lost.raw(), 0);
+    }
+}
+
+/// Wire version 2 first let a 50 Hz sender's counter fall behind the session time by 19 ms a
+/// frame: a member that joined 6 h into the session looked for it within 2^8 periods of 2^16 ms
+/// below its time (4.66 h) and never found it. Now its counter is within `MAX_LAG_MS`.
+#[test]
+fn a_member_joining_6_hours_in_takes_a_50_hz_sender_at_its_first_frame() {
+    const JOIN: u32 = 6 * 3_600_000;
+    // The teleop's heartbeat (CMAC), sealed at each announced time since the session opened.
+    let mut tx = Sender::new();
+    let times: Vec<u32> = (0..JOIN + 100).step_by(20).collect();
+    let expected = slow_sender_counters(&times);
+    let frames: Vec<Frame> = times
+        .iter()
+        .map(|&ms| {
+            let session = Session::owned(TEST_KEY, OLD).at(SessionTime::from_ms(ms));
+            tx.seal(&session, &heartbeat(ms)).unwrap()
+        })
+        .collect();
+    let at_join = times.iter().position(|&ms| ms == JOIN).unwrap();
+    assert!(JOIN - expected[at_join] <= MAX_LAG_MS);
+    let mut member = member_at(OLD, JOIN);
+    for (k, frame) in frames.iter().enumerate().skip(at_join) {
+        let decoded = decode_frame(frame.id(), frame.data()).unwrap();
+        assert_eq!(decoded.counter, expected[k] as u16);
+        let status = receive(&mut member, frame).unwrap().status;
+        let want = if k == at_join {
+            E2eStatus::Initial
+        } else {
+            E2eStatus::Ok
+        };
+        assert_eq!(status, want, "{}", times[k]);
+    }
+    assert_eq!(member.counters().total(), 0);
+    assert_eq!(member.counters().lost.raw(), 0);
+}
+
+/// Loss of a 50 Hz sender over 10 minutes, at the controller and at a member. Every
+/// `MAX_LAG_MS` (863 frames) its counter jumps to the session time: further than the time
+/// elapsed since its previous frame, so the sequence restarts there (`Initial`) and the jump
+/// is no loss. With every 10th frame dropped, every dropped frame counts as lost but those
+/// next to a jump (the jump frame itself, or the frame just before it): there the receiver
+/// sees the jump and no loss. (Wire version 2 first had no jumps, and a member that joined
+/// late never took such a sender at all.)
+#[test]
+fn a_50_hz_sender_loses_exactly_the_frames_dropped() {
+    let times: Vec<u32> = (1_000..1_000 + 10 * 60_000 + 20).step_by(20).collect();
+    let expected = slow_sender_counters(&times);
+    let jump: Vec<bool> = (0..times.len())
+        .map(|k| k > 0 && expected[k] != expected[k - 1] + 1)
+        .collect();
+    let jumps = jump.iter().filter(|j| **j).count();
+    assert_eq!(jumps, times.len() / 863);
+    assert_eq!(jump.iter().position(|j| *j), Some(863));
+    for every in [None, Some(10)] {
+        let dropped = |k: usize| every.is_some_and(|n| k % n == n - 1);
+        let mut clock = Clock::new(1_000);
+        let mut controller = owner_at(OLD, 1_000);
+        let mut drive = member_at(OLD, 1_000);
+        let mut teleop = member_at(OLD, 1_000);
+        let mut tx = Sender::new();
+        let mut initial = 0;
+        for (k, &ms) in times.iter().enumerate() {
+            clock.to(ms, &mut controller, &mut [&mut drive, &mut teleop]);
+            let frame = tx.seal(teleop.session(), &heartbeat(ms)).unwrap();
+            let decoded = decode_frame(frame.id(), frame.data()).unwrap();
+            assert_eq!(decoded.counter, expected[k] as u16, "{ms}");
+            if dropped(k) {
+                continue;
+            }
+            let statuses =
+                [&mut controller, &mut drive].map(|rx| receive(rx, &frame).unwrap().status);
+            assert_eq!(statuses[0], statuses[1], "{ms}");
+            let after_drop = k > 0 && dropped(k - 1);
+            let want = match (k == 0 || jump[k] || (after_drop && jump[k - 1]), after_drop) {
+                (true, _) => E2eStatus::Initial,
+                (false, true) => E2eStatus::OkSomeLost { lost: 1 },
+                (false, false) => E2eStatus::Ok,
+            };
+            assert_eq!(statuses[0], want, "frame {k} at {ms} ms");
+            initial += usize::from(want == E2eStatus::Initial);
+        }
+        let dropped_all = (0..times.len()).filter(|&k| dropped(k)).count();
+        let dropped_at_jump = (0..times.len())
+            .filter(|&k| dropped(k) && (jump[k] || jump.get(k + 1) == Some(&true)))
+            .count();
+        match every {
+            None => {
+                assert_eq!(dropped_all, 0);
+                assert_eq!(initial, 1 + jumps);
+            }
+            Some(_) => {
+                assert_eq!(dropped_all, times.len() / 10);
+                // The jumps fall on frames 863·i: frame 863·i is dropped for i = 3, 13, 23, 33,
+                // and the one before it for i = 10, 20, 30.
+                assert_eq!(dropped_at_jump, 7);
+            }
+        }
+        for rx in [&controller, &drive] {
+            assert_eq!(rx.counters().total(), 0);
+            assert_eq!(
+                usize::from(rx.counters().lost.raw()),
+                dropped_all - dropped_at_jump,
+                "{every:?}"
+            );
+        }
+    }
+}
+
+/// An E-stop release counts with the session time, so two releases 10 s apart are 10 000
+/// counters apart: in sequence, but not 9 999 lost frames. Wire version 2 first counted them.
+#[test]
+fn two_releases_10_s_apart_count_no_loss() {
+    let mut clock = Clock::new(1_000);
+    let mut controller = owner_at(OLD, 1_000);
+    let mut drive = member_at(OLD, 1_000);
+    let mut teleop = member_at(OLD, 1_000);
+    let mut tx = Sender::new();
+    let release = AnyMessage::EStop(EStop::release(NodeId::Teleop, ReleaseToken::new(1)));
+    let latch = AnyMessage::EStop(EStop::latch(NodeId::Teleop));
+    let mut statuses = Vec::new();
+    for ms in [2_000, 12_000] {
+        clock.to(ms, &mut controller, &mut [&mut drive, &mut teleop]);
+        let frame = tx.seal(teleop.session(), &release).unwrap();
+        assert_eq!(
+            decode_frame(frame.id(), frame.data()).unwrap().counter,
+            ms as u16
+        );
+        for rx in [&mut controller, &mut drive] {
+            statuses.push(receive(rx, &frame).unwrap().status);
+        }
+        // And a latch in between, which takes no part in the sequence.
+        let frame = tx.seal(teleop.session(), &latch).unwrap();
+        for rx in [&mut controller, &mut drive] {
+            receive(rx, &frame).unwrap();
+        }
+    }
+    let gap = E2eStatus::OkSomeLost { lost: 9_999 };
+    assert_eq!(statuses, [E2eStatus::Initial, E2eStatus::Initial, gap, gap]);
+    for rx in [&controller, &drive] {
+        assert_eq!(rx.counters().lost.raw(), 0);
+        assert_eq!(rx.counters().total(), 0);
+    }
+    // Any other identifier's gap of the same length is counted.
+    let mut member = member_at(OLD, 2_000);
+    receive(&mut member, &wheel_command(2_000, OLD)).unwrap();
+    receive(
+        &mut member,
+        &announce_frame_at(WireVersion::THIS, OLD, 12_000, 600),
+    )
+    .unwrap();
+    assert_eq!(
+        receive(&mut member, &wheel_command(12_000, OLD))
+            .unwrap()
+            .status,
+        gap
+    );
+    assert_eq!(member.counters().lost.raw(), 9_999);
 }
 
 /// Wire version 2 first counted E-stop releases like any identifier, from zero per sender, so
@@ -1638,17 +1928,20 @@ fn two_operators_releasing_in_turn_are_both_taken() {
     let release = |source| AnyMessage::EStop(EStop::release(source, ReleaseToken::new(3)));
     let latch = |source| AnyMessage::EStop(EStop::latch(source));
     let mut statuses = Vec::new();
-    // Times away from a 2^16 ms boundary of the session time: the controller tries only the
-    // half of its time and the next, and a release sealed at an announced time just before a
-    // boundary that the controller has passed is in neither.
+    // Among them times just past a 2^16 ms boundary of the controller's time (65 536,
+    // 131 072), where the operator seals at the last announced time, just before it.
     for (ms, source) in [
         (10_020, NodeId::Teleop),
         (12_040, NodeId::Tool),
         (12_150, NodeId::Teleop),
         (30_010, NodeId::Teleop),
         (31_000, NodeId::Tool),
+        (65_538, NodeId::Teleop),
+        (65_600, NodeId::Tool),
         (100_000, NodeId::Tool),
         (100_130, NodeId::Teleop),
+        (131_075, NodeId::Tool),
+        (131_190, NodeId::Teleop),
         (190_500, NodeId::Teleop),
         (190_610, NodeId::Tool),
     ] {
