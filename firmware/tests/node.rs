@@ -308,3 +308,42 @@ fn an_estop_in_a_teleop_flood_acts() {
     assert_eq!(node.controller().state(), State::EStop);
     assert_eq!(node.reject_counters().total(), 18 + 20 + 38);
 }
+
+#[test]
+fn a_tick_that_freezes_or_goes_back_faults_with_sync_lost_until_stop() {
+    let mut node = node();
+    let joints = common::standing_joints_rad(&Config::ROBOT);
+    let mut plant = Sender::new();
+    let mut teleop = Sender::new();
+    let mut tick = |node: &mut Node, now: u32| {
+        for message in common::plant_feedback(&joints) {
+            let frame = seal(&mut plant, &message);
+            node.on_frame(Tick(now), frame.id(), frame.data()).unwrap();
+        }
+        node.poll(Tick(now)).0
+    };
+    for now in 0..20 {
+        tick(&mut node, now);
+    }
+    assert_eq!(node.controller().state(), State::Hold);
+    // The lockstep SYNC freezes at tick 19: the next poll is at the same tick.
+    let output = tick(&mut node, 19);
+    assert_eq!(node.controller().state(), State::Fault);
+    assert!(output
+        .status
+        .faults
+        .contains(protocol::FaultFlags::SYNC_LOST));
+    // Going back is the same; advancing clears the cause, and STOP then leaves the fault.
+    tick(&mut node, 3);
+    assert_eq!(node.controller().state(), State::Fault);
+    let output = tick(&mut node, 4);
+    assert!(!output
+        .status
+        .faults
+        .contains(protocol::FaultFlags::SYNC_LOST));
+    assert_eq!(node.controller().state(), State::Fault);
+    let stop = teleop_frame(&mut teleop, TeleopMode::Stop);
+    node.on_frame(Tick(5), stop.id(), stop.data()).unwrap();
+    tick(&mut node, 5);
+    assert_eq!(node.controller().state(), State::Hold);
+}

@@ -50,6 +50,9 @@ pub struct Controller {
     /// Whether the node's link monitor finds the bus too lossy (see
     /// [`Controller::set_link_degraded`]).
     link_degraded: bool,
+    /// Whether the last tick did not come after the one before (see
+    /// [`Controller::set_clock_stalled`]).
+    clock_stalled: bool,
     ik_failures: u32,
     /// The controlled stop of the present E-stop (`None` outside `EStop`).
     stop: Option<Stop>,
@@ -79,6 +82,7 @@ impl Controller {
             tilted: false,
             non_finite: false,
             link_degraded: false,
+            clock_stalled: false,
             ik_failures: 0,
             stop: None,
         })
@@ -128,6 +132,17 @@ impl Controller {
             self.apply(Event::LinkDegraded);
         }
         self.link_degraded = degraded;
+    }
+
+    /// Tells the controller that this tick did not come after the previous one (`stalled`): in
+    /// lockstep the tick is the simulator's SYNC, and a SYNC whose tick froze or went back would
+    /// freeze every watchdog. The controller faults ([`FaultFlags::SYNC_LOST`]) and stays in
+    /// `Fault` until the ticks advance again and the operator sends STOP.
+    pub fn set_clock_stalled(&mut self, stalled: bool) {
+        if stalled && !self.clock_stalled {
+            self.apply(Event::Fault);
+        }
+        self.clock_stalled = stalled;
     }
 
     /// Takes one accepted message received at `now`. Messages the controller does not consume
@@ -280,6 +295,9 @@ impl Controller {
         }
         if self.drive_faults.iter().any(|&faulted| faulted) {
             faults = faults.with(FaultFlags::DRIVE_FAULT);
+        }
+        if self.clock_stalled {
+            faults = faults.with(FaultFlags::SYNC_LOST);
         }
         faults
     }

@@ -61,6 +61,7 @@ pub struct Node {
     announced: bool,
     started: Option<Tick>,
     advanced: Option<Tick>,
+    polled: Option<Tick>,
     encode_failures: u32,
 }
 
@@ -85,6 +86,7 @@ impl Node {
             announced: false,
             started: None,
             advanced: None,
+            polled: None,
             encode_failures: 0,
         })
     }
@@ -209,7 +211,14 @@ impl Node {
     /// Runs one control tick and returns its output and the frames due. The frames received
     /// until the next call get a fresh operator-command budget, and the link monitor's verdict
     /// reaches the controller before its step.
+    ///
+    /// A tick that does not come after the previous one (a lockstep SYNC that froze or went
+    /// back) faults the controller with `SYNC_LOST` ([`Controller::set_clock_stalled`]).
     pub fn poll(&mut self, now: Tick) -> (Output, TickFrames) {
+        let ahead = self.polled.map(|previous| now.since(previous));
+        self.controller
+            .set_clock_stalled(ahead.is_some_and(|ticks| ticks == 0 || ticks >= 1 << 31));
+        self.polled = Some(now);
         self.advance(now);
         self.teleop_budget.refill();
         let degraded = self.link.update(now);
