@@ -7,6 +7,7 @@ use std::collections::VecDeque;
 use protocol::{EncodeError, Frame, MessageId};
 use teleop_core::bus_status::BusStatus;
 use teleop_core::keys::{action, Action, Key};
+use teleop_core::link::OperatorLink;
 use teleop_core::operator::{Operator, Outcome};
 use teleop_core::release::ReleaseOutcome;
 
@@ -42,11 +43,17 @@ pub struct App {
 }
 
 impl App {
-    /// An operator on the bus called `bus_name` (shown in the title).
+    /// An operator on the bus called `bus_name` (shown in the title), with the simulation's
+    /// test key.
     pub fn new(bus_name: &str) -> Self {
+        Self::with_key(bus_name, protocol::TEST_KEY)
+    }
+
+    /// An operator on the bus called `bus_name`, sealing its frames with `key`.
+    pub fn with_key(bus_name: &str, key: protocol::Key) -> Self {
         Self {
             bus_name: bus_name.to_owned(),
-            operator: Operator::new(),
+            operator: Operator::with_link(OperatorLink::new(key)),
             status: BusStatus::default(),
             sim: None,
             last_heartbeat_ms: None,

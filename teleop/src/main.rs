@@ -43,6 +43,10 @@ struct Cli {
     /// With `--bus inproc`: write telemetry.csv, bus.log and plots here when teleop ends.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// The bus key: a file holding 32 hexadecimal digits, readable by this account only (as
+    /// firmware-host's). Without it, the public test key of simulation and CI.
+    #[arg(long, value_name = "PATH")]
+    key_file: Option<PathBuf>,
     #[command(subcommand)]
     command: Option<Command>,
 }
@@ -133,6 +137,11 @@ fn run(cli: Cli) -> Result<(), Failure> {
         _ => None,
     };
     if cli.bus == "inproc" {
+        if cli.key_file.is_some() {
+            return Err(Failure::usage(
+                "--key-file belongs to a CAN bus (the in-process robot uses the test key)".into(),
+            ));
+        }
         return inproc(&cli, scenario.as_ref(), &stop);
     }
     if cli.model.is_some() || cli.out.is_some() {
@@ -140,6 +149,8 @@ fn run(cli: Cli) -> Result<(), Failure> {
             "--model and --out belong to --bus inproc (on a CAN bus the robot is elsewhere)".into(),
         ));
     }
+    let key = host_can::key_file::load(cli.key_file.as_deref())
+        .map_err(|e| Failure::usage(e.to_string()))?;
     let mut bus = SocketCanBus::open(&cli.bus).map_err(|e| {
         let hint = if e.is_missing_interface() {
             "\n(or drive the simulated robot without CAN: `--bus inproc`)"
@@ -148,20 +159,21 @@ fn run(cli: Cli) -> Result<(), Failure> {
         };
         Failure::bus(format!("{e}{hint}"))
     })?;
-    operate(&mut bus, &cli, scenario.as_ref(), &stop, &mut || None)
+    operate(&mut bus, &cli, key, scenario.as_ref(), &stop, &mut || None)
 }
 
 /// Runs the chosen mode on `bus`; `live` gives ground truth when the robot is simulated here.
 fn operate(
     bus: &mut dyn Bus,
     cli: &Cli,
+    key: protocol::Key,
     scenario: Option<&Scenario>,
     stop: &AtomicBool,
     live: &mut dyn FnMut() -> Option<teleop::app::SimView>,
 ) -> Result<(), Failure> {
     let report = match (&cli.command, scenario) {
         (None, _) => {
-            let report = teleop::terminal::run(bus, &cli.bus, live, stop)
+            let report = teleop::terminal::run(bus, &cli.bus, key, live, stop)
                 .map_err(|e| Failure::bus(e.to_string()))?;
             println!(
                 "teleop: sent {} frames on {}; the robot was told to stop{}",
@@ -175,9 +187,13 @@ fn operate(
             );
             return Ok(());
         }
-        (Some(Command::Send { key, seconds }), _) => {
-            script::send(bus, *key, Duration::from_secs_f64(*seconds), stop)
-        }
+        (
+            Some(Command::Send {
+                key: action,
+                seconds,
+            }),
+            _,
+        ) => script::send(bus, key, *action, Duration::from_secs_f64(*seconds), stop),
         (Some(Command::Script { .. }), Some(scenario)) => {
             println!(
                 "teleop: script `{}`, {} steps over {:.1} s on {}",
@@ -186,7 +202,7 @@ fn operate(
                 scenario.duration_s,
                 cli.bus
             );
-            script::run(bus, scenario, stop, |index| {
+            script::run(bus, key, scenario, stop, |index| {
                 if let Some(step) = scenario.steps.get(index) {
                     println!(
                         "  t = {:6.2} s  {:<5} {}",
@@ -247,7 +263,14 @@ fn inproc(cli: &Cli, scenario: Option<&Scenario>, stop: &AtomicBool) -> Result<(
         }
         robot.view()
     };
-    let result = operate(&mut endpoint, cli, scenario, stop, &mut live);
+    let result = operate(
+        &mut endpoint,
+        cli,
+        protocol::TEST_KEY,
+        scenario,
+        stop,
+        &mut live,
+    );
     let last = robot.view();
     let finished = robot.finish();
     result?;

@@ -11,6 +11,7 @@ use host_can::bus::{Bus, BusError};
 use protocol::{ControllerMode, EncodeError, Frame};
 use teleop_core::bus_status::BusStatus;
 use teleop_core::keys::Action;
+use teleop_core::link::OperatorLink;
 use teleop_core::operator::Operator;
 use teleop_core::scenario::Scenario;
 use teleop_core::scripted::ScriptedTeleop;
@@ -50,11 +51,12 @@ const ARM_MS: u64 = 2 * teleop_core::operator::PERIOD_MS;
 /// Presses `key` (after a STOP, which the controller's interlock wants first) and keeps the command and heartbeat going for `hold`.
 pub fn send(
     bus: &mut dyn Bus,
+    bus_key: protocol::Key,
     key: Action,
     hold: Duration,
     stop: &AtomicBool,
 ) -> Result<ScriptReport, ScriptError> {
-    let mut operator = Operator::new();
+    let mut operator = Operator::with_link(OperatorLink::new(bus_key));
     // The controller starts interlocked: a motion key is sent after a STOP, as a script does.
     let motion = key;
     operator.press(0, Action::Mode(protocol::TeleopMode::Stop));
@@ -79,11 +81,12 @@ pub fn send(
 /// starts.
 pub fn run(
     bus: &mut dyn Bus,
+    bus_key: protocol::Key,
     scenario: &Scenario,
     stop: &AtomicBool,
     mut on_step: impl FnMut(usize),
 ) -> Result<ScriptReport, ScriptError> {
-    let mut teleop = ScriptedTeleop::new(scenario.plan());
+    let mut teleop = ScriptedTeleop::with_link(scenario.plan(), OperatorLink::new(bus_key));
     let mut started = 0;
     let hold = Duration::from_secs_f64(scenario.duration_s);
     serve(bus, hold, stop, |now_ms, heard| {

@@ -43,11 +43,12 @@ pub struct TerminalReport {
 pub fn run(
     bus: &mut dyn Bus,
     bus_name: &str,
+    key: protocol::Key,
     mut live: impl FnMut() -> Option<SimView>,
     stop: &AtomicBool,
 ) -> Result<TerminalReport, TerminalError> {
     let mut terminal = ratatui::try_init()?;
-    let result = serve(&mut terminal, bus, bus_name, &mut live, stop);
+    let result = serve(&mut terminal, bus, (bus_name, key), &mut live, stop);
     ratatui::try_restore()?;
     result
 }
@@ -55,13 +56,13 @@ pub fn run(
 fn serve(
     terminal: &mut ratatui::DefaultTerminal,
     bus: &mut dyn Bus,
-    bus_name: &str,
+    (bus_name, key): (&str, protocol::Key),
     live: &mut dyn FnMut() -> Option<SimView>,
     stop: &AtomicBool,
 ) -> Result<TerminalReport, TerminalError> {
     let start = Instant::now();
     let now_ms = || u64::try_from(start.elapsed().as_millis()).unwrap_or(u64::MAX);
-    let mut app = App::new(bus_name);
+    let mut app = App::with_key(bus_name, key);
     let mut last_error = String::new();
     let mut next_draw = Instant::now();
     while !app.quit_requested() && !stop.load(Ordering::Relaxed) {

@@ -77,3 +77,23 @@ fn inproc_send_drives_the_simulated_robot_without_any_can() {
         .unwrap_or_else(|| panic!("{stdout}"));
     assert!(x > 0.15, "trotted {x} m in 4 s: {stdout}");
 }
+
+#[test]
+fn a_key_file_that_is_missing_or_malformed_exits_2_naming_it() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let out = teleop(&["--key-file", "no/such/robot.key", "send", "X"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(stderr(&out).contains("key file no/such/robot.key"));
+    let file = dir.join("short.key");
+    std::fs::write(&file, "0011\n").unwrap();
+    let out = teleop(&["--key-file", &file.to_string_lossy(), "send", "X"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("32 hexadecimal digits"),
+        "{}",
+        stderr(&out)
+    );
+    let out = teleop(&["--bus", "inproc", "--key-file", &file.to_string_lossy()]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--key-file belongs to a CAN bus"));
+}

@@ -22,12 +22,49 @@ use crate::timer::ControlTimer;
 const CONFIG: Config = Config::ROBOT;
 
 /// The bus key, from `ROBOT_KEY_HEX` (32 hexadecimal digits) at build time; the public test
-/// key when it is unset. Not yet persisted or provisioned on the part itself: see
+/// key when it is unset. A value that is not a key fails the build (an image must never fall
+/// back to the public key unnoticed). Not yet provisioned on the part itself: see
 /// `docs/mcu.md`, "Keys and epochs".
+const KEY: protocol::Key = match option_env!("ROBOT_KEY_HEX") {
+    None => protocol::TEST_KEY,
+    Some(hex) => match key_from_hex(hex.as_bytes()) {
+        Some(key) => key,
+        // Evaluated at compile time: this stops the build, it cannot happen on the board.
+        #[allow(clippy::panic)]
+        None => panic!("ROBOT_KEY_HEX must be exactly 32 hexadecimal digits"),
+    },
+};
+
 fn key() -> protocol::Key {
-    option_env!("ROBOT_KEY_HEX")
-        .and_then(|hex| protocol::Key::from_hex(hex).ok())
-        .unwrap_or(protocol::TEST_KEY)
+    KEY
+}
+
+/// 32 hexadecimal digits as a key, at compile time.
+// Indexing in const evaluation: out of bounds is a build error, not a panic.
+#[allow(clippy::indexing_slicing)]
+const fn key_from_hex(hex: &[u8]) -> Option<protocol::Key> {
+    if hex.len() != 32 {
+        return None;
+    }
+    let mut key = [0_u8; 16];
+    let mut i = 0;
+    while i < 16 {
+        let (Some(high), Some(low)) = (hex_digit(hex[2 * i]), hex_digit(hex[2 * i + 1])) else {
+            return None;
+        };
+        key[i] = high << 4_u32 | low;
+        i += 1;
+    }
+    Some(protocol::Key(key))
+}
+
+const fn hex_digit(c: u8) -> Option<u8> {
+    match c {
+        b'0'..=b'9' => Some(c - b'0'),
+        b'a'..=b'f' => Some(c - b'a' + 10),
+        b'A'..=b'F' => Some(c - b'A' + 10),
+        _ => None,
+    }
 }
 
 /// The session epoch of this start. The board does not yet keep its epoch in a backup
