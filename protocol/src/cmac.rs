@@ -7,14 +7,20 @@
 
 use crate::aes::Aes128;
 
-/// A key ready to compute CMACs.
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// A key ready to compute CMACs. Its debug output shows nothing of the key or the subkeys.
+#[derive(Clone, PartialEq, Eq)]
 pub struct CmacKey {
     cipher: Aes128,
     /// Subkey for a message whose last block is complete.
     k1: [u8; 16],
     /// Subkey for a message whose last block is padded.
     k2: [u8; 16],
+}
+
+impl core::fmt::Debug for CmacKey {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("CmacKey(…)")
+    }
 }
 
 /// Doubling in GF(2^128) as CMAC defines it.

@@ -214,7 +214,8 @@ impl core::fmt::Display for DecodeError {
             ),
             DecodeError::StaleSession { id } => write!(
                 f,
-                "CAN id 0x{id:03X}: announcement of an older session (a replay)"
+                "CAN id 0x{id:03X}: announcement of another session: an older one (a replay), or, \
+                 heard by a controller, another controller on the bus"
             ),
             DecodeError::WireVersion { theirs } => write!(
                 f,

@@ -65,11 +65,17 @@ pub fn send(
     if pressed {
         operator.press(0, motion);
     }
+    // The motion goes ARM_MS after the session is joined, so that the STOP went out first.
+    let mut joined_ms = None;
     serve(bus, hold, stop, |now_ms, heard| {
         for frame in heard {
             operator.observe(frame);
         }
-        if !pressed && operator.joined() && now_ms >= ARM_MS {
+        if operator.joined() && joined_ms.is_none() {
+            joined_ms = Some(now_ms);
+        }
+        let armed = joined_ms.is_some_and(|t| now_ms >= t.saturating_add(ARM_MS));
+        if !pressed && armed {
             operator.press(now_ms, motion);
             pressed = true;
         }

@@ -22,6 +22,8 @@ cargo xtask frame release --epoch N --time-ms T --token N [--key-file FILE] [--b
 cargo xtask frame command MODE --epoch N --time-ms T [--height-m H] [--speed-pct P]
                           [--key-file FILE] [--bus IFACE]
   MODE: the report's keys W S A L K X, or stand, fold; IFACE defaults to vcan0;
+  --time-ms is the Announce's `time` in ms (cantools shows it in seconds); the frame is
+  found by the controller for about 98 s after that time;
   without --key-file the public test key of the simulation is used";
 
 /// What the command line asks for.

@@ -122,9 +122,17 @@ impl StateFile {
         if let Some(dir) = self.path.parent().filter(|d| !d.as_os_str().is_empty()) {
             fs::create_dir_all(dir).map_err(io)?;
         }
+        // Written, synced, renamed over the old file, and the directory synced: after a power
+        // loss the file holds the old state or the new one, never a rolled-back epoch.
         let temporary = self.path.with_extension("tmp");
-        fs::write(&temporary, text).map_err(io)?;
-        fs::rename(&temporary, &self.path).map_err(io)
+        let mut file = fs::File::create(&temporary).map_err(io)?;
+        std::io::Write::write_all(&mut file, text.as_bytes()).map_err(io)?;
+        file.sync_all().map_err(io)?;
+        fs::rename(&temporary, &self.path).map_err(io)?;
+        if let Some(dir) = self.path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            fs::File::open(dir).and_then(|d| d.sync_all()).map_err(io)?;
+        }
+        Ok(())
     }
 }
 

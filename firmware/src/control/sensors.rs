@@ -57,11 +57,15 @@ impl Sensors {
         self.wheels.feed(now);
     }
 
-    /// Stores an IMU sample. A quaternion that gives no attitude (all zero) does not count as a
-    /// sample.
+    /// Stores an IMU sample. An all-zero sample (what an IMU that is not initialised or broken
+    /// sends: no rotation, no rate, and no specific force, which a robot on the ground always
+    /// feels) does not count as a sample; neither does a quaternion that gives no attitude.
     pub fn record_imu(&mut self, now: Tick, imu: &Imu) {
+        let zero = imu.orientation.iter().all(|c| c.raw() == 0)
+            && imu.angular_rate.iter().all(|w| w.raw() == 0)
+            && imu.acceleration.iter().all(|a| a.raw() == 0);
         let attitude = Attitude::from_quaternion(imu.quaternion(crate::math::sqrt));
-        if attitude.tilt_rad().is_finite() {
+        if !zero && attitude.tilt_rad().is_finite() {
             self.attitude = attitude;
             self.angular_rate_rad_s = imu.angular_rate.map(|w| w.si());
             self.imu.feed(now);

@@ -41,8 +41,9 @@ impl Teleop {
         }
     }
 
-    /// Records a command; returns the mode if it is a new request the interlock lets through
-    /// (any STOP, which also releases the interlock; anything else only once released).
+    /// Records a command; returns the mode if it is a new request the interlock lets through: a
+    /// new STOP, or the STOP that releases the interlock; anything else only once released. A
+    /// STOP repeated by an idle operator is not a new request (it resets no fault).
     pub fn command(&mut self, now: Tick, command: &TeleopCommand) -> Option<TeleopMode> {
         self.watchdog.feed(now);
         self.alive = true;
@@ -51,8 +52,8 @@ impl Teleop {
         let new = self.last_mode != Some(command.mode);
         self.last_mode = Some(command.mode);
         if command.mode == TeleopMode::Stop {
-            self.interlocked = false;
-            return Some(command.mode);
+            let released = core::mem::replace(&mut self.interlocked, false);
+            return (new || released).then_some(command.mode);
         }
         (new && !self.interlocked).then_some(command.mode)
     }

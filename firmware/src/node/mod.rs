@@ -1,7 +1,7 @@
 //! The controller as a CAN node: frames in, frames out, still sans-IO.
 //!
 //! [`Node::on_frame`] runs every received frame through the protocol's
-//! [`Receiver`] — decode, CRC, rolling counter — so that nothing rejected
+//! [`Receiver`] — check value (CRC-32C or CMAC) in the session, counter, decode — so that nothing rejected
 //! reaches the controller, and every rejection is counted by cause. Two guards sit between the
 //! receiver and the controller:
 //!
@@ -59,7 +59,9 @@ pub struct Node {
     sender: Sender,
     release_token: ReleaseToken,
     announced: bool,
-    started: Option<Tick>,
+    /// Ticks the session has run (only ever counted forward) and the tick they were counted to.
+    session_ticks: u32,
+    counted_to: Option<Tick>,
     advanced: Option<Tick>,
     polled: Option<Tick>,
     encode_failures: u32,
@@ -82,9 +84,14 @@ impl Node {
             link,
             controller: Controller::new(config)?,
             sender: Sender::new(),
-            release_token: ReleaseToken::new(0),
+            // Seeded from the epoch, so that a latch restored after a restart does not take the
+            // token a release sent before the restart carried.
+            release_token: ReleaseToken::new(
+                session.epoch().map_or(0, |e| (e.raw() & 0xFFFF) as u16),
+            ),
             announced: false,
-            started: None,
+            session_ticks: 0,
+            counted_to: None,
             advanced: None,
             polled: None,
             encode_failures: 0,
@@ -161,15 +168,20 @@ impl Node {
                 return Err(self.refuse(DecodeError::StaleRelease { id: raw_id }));
             }
         }
-        if !matches!(accepted.message, AnyMessage::TeleopHeartbeat(_)) {
+        // Heartbeats (see above) and E-stops (their counters jump with the session time) are
+        // not counted in the link's loss.
+        if !matches!(
+            accepted.message,
+            AnyMessage::TeleopHeartbeat(_) | AnyMessage::EStop(_)
+        ) {
             self.link.record(accepted.status);
         }
         self.act(now, &accepted.message);
         Ok(())
     }
 
-    /// The session time is the time since this node's first call: what every sender's
-    /// counters start at.
+    /// A new tick moves the session time (what every sender's counters start at and the
+    /// receiver places them against) by the ticks counted since the previous one.
     fn advance(&mut self, now: Tick) {
         if self.advanced == Some(now) {
             return;
@@ -184,13 +196,21 @@ impl Node {
         !self.announced || slot_of(MessageId::Announce).is_some_and(|slot| slot.sends_in(now.0, hz))
     }
 
+    /// The session time only ever moves forward: a tick that goes back (a restarted
+    /// simulator's SYNC in lockstep) or repeats adds nothing, and counting resumes from it.
     fn set_time(&mut self, now: Tick) {
-        let started = *self.started.get_or_insert(now);
+        if let Some(previous) = self.counted_to {
+            let ahead = now.since(previous);
+            if ahead < 1 << 31 {
+                self.session_ticks = self.session_ticks.saturating_add(ahead);
+            }
+        }
+        self.counted_to = Some(now);
         let ms = self
             .controller
             .config()
             .rate
-            .ms_from_ticks(now.since(started));
+            .ms_from_ticks(self.session_ticks);
         self.receiver.set_time(SessionTime::from_ms(ms));
     }
 
@@ -199,11 +219,16 @@ impl Node {
         error
     }
 
-    /// Hands an accepted message to the controller; a new latch gets a new release token.
+    /// Hands an accepted message to the controller. Every accepted latch gets a new release
+    /// token, a latch while latched included: a release sent before it answers an older latch
+    /// and is refused, so a later E-stop is never undone by an earlier release.
     fn act(&mut self, now: Tick, message: &AnyMessage) {
-        let latched_before = self.estop_latched();
         self.controller.on_message(now, message);
-        if self.estop_latched() && !latched_before {
+        if let AnyMessage::EStop(EStop {
+            action: EStopAction::Latch,
+            ..
+        }) = message
+        {
             self.release_token = self.release_token.next();
         }
     }

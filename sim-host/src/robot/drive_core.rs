@@ -10,7 +10,8 @@
 //! can keep it moving.
 
 use protocol::{
-    AnyMessage, Count, DriveFlags, DriveStatus, EStopAction, EncodeError, Frame, Key, MessageId,
+    AnyMessage, ControllerMode, Count, DriveFlags, DriveStatus, EStopAction, EncodeError, Frame,
+    Key, MessageId,
 };
 
 use crate::robot::link::NodeLink;
@@ -42,6 +43,10 @@ pub struct DriveCore {
     commanded_enable: bool,
     /// When the E-stop latched, µs (`None`: not latched). A repeated latch keeps the first time.
     estop_since_us: Option<u64>,
+    /// An authentic release was heard since the last latch: the E-stop clears when the
+    /// controller's status shows it left its own (it checks the release's token; a release it
+    /// refused leaves the drives latched too).
+    release_heard: bool,
     rejected: u32,
     commands: u32,
 }
@@ -56,6 +61,7 @@ impl DriveCore {
             last_command_us: None,
             commanded_enable: false,
             estop_since_us: None,
+            release_heard: false,
             rejected: 0,
             commands: 0,
         }
@@ -66,17 +72,32 @@ impl DriveCore {
     /// rejected frame is counted and never returned.
     pub fn on_frame(&mut self, now_us: u64, frame: &Frame) -> Option<AnyMessage> {
         let id = frame.id();
-        let filter = [MessageId::EStop, MessageId::Announce, self.listens_to];
+        let filter = [
+            MessageId::EStop,
+            MessageId::Announce,
+            MessageId::ControllerStatus,
+            self.listens_to,
+        ];
         if !filter.iter().any(|listened| listened.raw() == id) {
             return None;
         }
         match self.link.receive(id, frame.data()) {
             Ok(accepted) => match accepted.message {
                 AnyMessage::EStop(estop) => {
-                    self.estop_since_us = match estop.action {
-                        EStopAction::Latch => self.estop_since_us.or(Some(now_us)),
-                        EStopAction::Clear => None,
-                    };
+                    match estop.action {
+                        EStopAction::Latch => {
+                            self.estop_since_us = self.estop_since_us.or(Some(now_us));
+                            self.release_heard = false;
+                        }
+                        EStopAction::Clear => self.release_heard = self.estop_since_us.is_some(),
+                    }
+                    None
+                }
+                AnyMessage::ControllerStatus(status) => {
+                    if self.release_heard && status.mode != ControllerMode::EStop {
+                        self.estop_since_us = None;
+                        self.release_heard = false;
+                    }
                     None
                 }
                 AnyMessage::Announce(_) => None,

@@ -17,8 +17,9 @@ use crate::release::{Release, ReleaseOutcome};
 /// Period of the command and heartbeat, ms (50 Hz).
 pub const PERIOD_MS: u64 = 20;
 /// The heartbeat goes out this long after the periodic command, ms: half a period apart, so
-/// that the controller checks one authenticated frame per tick (a CMAC is the dearest thing it
-/// does with a frame; see the bus schedule's phases).
+/// that in steady operation the controller checks one authenticated frame per tick (a CMAC is
+/// the dearest thing it does with a frame; see the bus schedule's phases). A key press or a
+/// release may still land in the heartbeat's tick.
 pub const HEARTBEAT_OFFSET_MS: u64 = PERIOD_MS / 2;
 /// How often an unconfirmed E-stop latch is sent again, ms: one control period of the
 /// controller at 250 Hz, so that on a lossy link the latch gets through within a few of them.
@@ -97,7 +98,14 @@ impl Operator {
     /// authentic status heard now confirms a latch this operator sent, gives the token a
     /// release must echo, and ends a release on its way.
     pub fn observe(&mut self, frame: &Frame) {
-        if let Some(AnyMessage::ControllerStatus(status)) = self.link.observe(frame) {
+        let epoch = self.link.epoch();
+        let heard = self.link.observe(frame);
+        if self.link.epoch() != epoch {
+            // A new session (the controller restarted): nothing of the old one's E-stop holds,
+            // least of all a release on its way.
+            self.release = Release::default();
+        }
+        if let Some(AnyMessage::ControllerStatus(status)) = heard {
             self.release.observe(&status);
             self.observe_controller(status.mode);
         }
@@ -183,6 +191,8 @@ impl Operator {
                 self.speed_scale_pct = speed;
             }
             Action::EStop => {
+                // A release on its way answers an older latch: it must not undo this one.
+                self.release.abandon();
                 self.estop_latched = true;
                 self.estop_confirmed = false;
                 self.latch_sent_ms = None;
@@ -247,8 +257,11 @@ impl Operator {
                 body_height: BodyHeight::saturating_from_si(self.body_height_m),
                 speed_scale: SpeedScale::saturating_from_si(self.speed_scale_pct),
             });
-            frames.extend(self.link.seal(&command)?);
-            self.command_changed = false;
+            // Before the session is joined nothing goes out, and a change waits for it.
+            if let Some(frame) = self.link.seal(&command)? {
+                frames.push(frame);
+                self.command_changed = false;
+            }
             if periodic {
                 self.next_send_ms = now_ms - now_ms % PERIOD_MS + PERIOD_MS;
             }

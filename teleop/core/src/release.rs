@@ -106,6 +106,12 @@ impl Release {
         }
     }
 
+    /// Drops a release on its way (the operator latched again: the release answered an older
+    /// latch).
+    pub fn abandon(&mut self) {
+        self.pending = None;
+    }
+
     /// Whether a release is on its way (the controller has not confirmed it yet).
     pub fn pending(&self) -> bool {
         self.pending.is_some()
