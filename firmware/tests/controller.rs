@@ -464,6 +464,12 @@ fn a_drive_fault_stops_the_robot_until_the_drive_recovers_and_the_operator_reset
         "the drive still reports its fault"
     );
     bench.send(status(DriveFlags::ENABLED));
+    // An idle operator repeating STOP resets nothing: the fault needs a new STOP.
+    for _ in 0..5 {
+        bench.send(command(TeleopMode::Stop));
+        bench.tick();
+    }
+    assert_eq!(bench.state(), State::Fault, "a repeated STOP is no reset");
     bench.send(command(TeleopMode::Stand));
     bench.send(command(TeleopMode::Stop));
     assert_eq!(bench.state(), State::Hold);

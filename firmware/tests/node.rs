@@ -347,3 +347,25 @@ fn a_tick_that_freezes_or_goes_back_faults_with_sync_lost_until_stop() {
     tick(&mut node, 5);
     assert_eq!(node.controller().state(), State::Hold);
 }
+
+#[test]
+fn a_release_sent_before_a_second_latch_does_not_undo_it() {
+    let mut node = node();
+    node.poll(Tick(0));
+    let latch = classic_latch(NodeId::Tool, 0).unwrap();
+    node.on_frame(Tick(1), latch.id(), latch.data()).unwrap();
+    let first = node.release_token();
+    // An operator released (the frame still on its way) and another latched meanwhile.
+    let mut tool = Sender::new();
+    let release = seal(
+        &mut tool,
+        &AnyMessage::EStop(EStop::release(NodeId::Tool, first)),
+    );
+    node.on_frame(Tick(2), latch.id(), latch.data()).unwrap();
+    assert_ne!(node.release_token(), first, "every latch takes a new token");
+    assert_eq!(
+        node.on_frame(Tick(3), release.id(), release.data()),
+        Err(DecodeError::StaleRelease { id: 0x000 })
+    );
+    assert_eq!(node.controller().state(), State::EStop);
+}

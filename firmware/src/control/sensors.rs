@@ -109,3 +109,31 @@ pub const fn leg_index(leg: Leg) -> usize {
         Leg::Br => 3,
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use protocol::{Acceleration, AngularRate, QuatComponent};
+
+    #[test]
+    fn an_all_zero_imu_sample_feeds_no_watchdog_and_a_level_one_does() {
+        let mut sensors = Sensors::new(10, 10);
+        let zero = Imu {
+            orientation: [QuatComponent::saturating_from_si(0.0); 3],
+            angular_rate: [AngularRate::saturating_from_si(0.0); 3],
+            acceleration: [Acceleration::saturating_from_si(0.0); 3],
+        };
+        for t in 0..20 {
+            sensors.record_imu(Tick(t), &zero);
+        }
+        assert!(sensors.imu_stale(Tick(20)), "zeros are no IMU");
+        // Level and at rest: the same quaternion, with gravity felt.
+        let level = Imu {
+            acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
+            ..zero
+        };
+        sensors.record_imu(Tick(20), &level);
+        assert!(!sensors.imu_stale(Tick(21)));
+        assert_eq!(sensors.attitude.tilt_rad(), 0.0);
+    }
+}

@@ -201,7 +201,7 @@ impl Node {
     fn set_time(&mut self, now: Tick) {
         if let Some(previous) = self.counted_to {
             let ahead = now.since(previous);
-            if ahead < 1 << 31 {
+            if ahead < 1_u32 << 31_u32 {
                 self.session_ticks = self.session_ticks.saturating_add(ahead);
             }
         }
@@ -242,7 +242,7 @@ impl Node {
     pub fn poll(&mut self, now: Tick) -> (Output, TickFrames) {
         let ahead = self.polled.map(|previous| now.since(previous));
         self.controller
-            .set_clock_stalled(ahead.is_some_and(|ticks| ticks == 0 || ticks >= 1 << 31));
+            .set_clock_stalled(ahead.is_some_and(|ticks| ticks == 0 || ticks >= 1_u32 << 31_u32));
         self.polled = Some(now);
         self.advance(now);
         self.teleop_budget.refill();

@@ -109,11 +109,15 @@ pub(super) fn flips_and_replays(
     };
     // Each drive checks the commands meant for it: every bad LegTargets must be refused by all
     // four leg drives, every bad WheelCommand by the wheel drive; and every drive checks the
-    // controller's session announcements, so a bad one is refused by all five.
+    // controller's session announcements and status (for the E-stop's release), so a bad one
+    // is refused by all five.
     let hardware = rig.sim().hardware();
     let bad_legs = rig.sim_bus().rx_bad_frames(MessageId::LegTargets.raw());
     let bad_wheels = rig.sim_bus().rx_bad_frames(MessageId::WheelCommand.raw());
-    let bad_announce = rig.sim_bus().rx_bad_frames(MessageId::Announce.raw());
+    let bad_announce = rig.sim_bus().rx_bad_frames(MessageId::Announce.raw())
+        + rig
+            .sim_bus()
+            .rx_bad_frames(MessageId::ControllerStatus.raw());
     let legs_refused: Vec<u64> = hardware
         .legs()
         .iter()

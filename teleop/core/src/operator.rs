@@ -285,8 +285,8 @@ mod tests {
     use super::*;
     use crate::keys::{action, Key};
     use protocol::{
-        Angle, Announce, BodyHeight, ControllerStatus, Epoch, FaultFlags, MessageId, Receiver,
-        ReleaseToken, Sender, Session, Tick, WireVersion,
+        decode_frame, Angle, Announce, BodyHeight, ControllerStatus, Epoch, FaultFlags, MessageId,
+        Receiver, ReleaseToken, Sender, Session, Tick, WireVersion,
     };
 
     /// The controller's side of the session, as far as an operator hears and is heard.
@@ -298,7 +298,11 @@ mod tests {
 
     impl FakeController {
         fn new() -> Self {
-            let session = Session::owned(TEST_KEY, Epoch::new(7));
+            Self::with_epoch(7)
+        }
+
+        fn with_epoch(epoch: u32) -> Self {
+            let session = Session::owned(TEST_KEY, Epoch::new(epoch));
             Self {
                 session,
                 sender: Sender::new(),
@@ -309,7 +313,7 @@ mod tests {
         fn announce(&mut self) -> Frame {
             let announce = AnyMessage::Announce(Announce {
                 version: WireVersion::THIS,
-                epoch: Epoch::new(7),
+                epoch: self.session.epoch().unwrap(),
                 time: self.session.time(),
             });
             self.sender.seal(&self.session, &announce).unwrap()
@@ -482,5 +486,45 @@ mod tests {
         }
         assert_eq!((op.body_height_m(), op.speed_scale_pct()), (-0.10, 0.0));
         assert_eq!(op.press(0, Action::Quit), Outcome::Quit);
+    }
+
+    #[test]
+    fn a_new_latch_or_a_new_session_drops_a_release_on_its_way() {
+        let releases = |frames: &[Frame]| {
+            frames
+                .iter()
+                .filter(|f| {
+                    matches!(
+                        decode_frame(f.id(), f.data()).map(|d| d.message),
+                        Ok(AnyMessage::EStop(EStop {
+                            action: EStopAction::Clear,
+                            ..
+                        }))
+                    )
+                })
+                .count()
+        };
+        let mut op = Operator::new();
+        let mut ctl = FakeController::new();
+        op.observe(&ctl.announce());
+        op.press(0, Action::EStop);
+        op.poll(0).unwrap();
+        op.observe(&ctl.status(ControllerMode::EStop));
+        op.press(100, Action::Release);
+        op.press(200, Action::Release);
+        assert_eq!(releases(&op.poll(200).unwrap()), 1);
+        // Latched again before the controller confirmed: the release stops.
+        op.press(210, Action::EStop);
+        let later: usize = (211..400).map(|t| releases(&op.poll(t).unwrap())).sum();
+        assert_eq!(later, 0, "no release after a new latch");
+        // Released again, then the controller restarts (a new session): the release stops too.
+        op.observe(&ctl.status(ControllerMode::EStop));
+        op.press(500, Action::Release);
+        op.press(600, Action::Release);
+        assert_eq!(releases(&op.poll(600).unwrap()), 1);
+        let mut restarted = FakeController::with_epoch(8);
+        op.observe(&restarted.announce());
+        let later: usize = (601..900).map(|t| releases(&op.poll(t).unwrap())).sum();
+        assert_eq!(later, 0, "no release into a new session");
     }
 }
