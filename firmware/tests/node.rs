@@ -355,14 +355,22 @@ fn a_release_sent_before_a_second_latch_does_not_undo_it() {
     let latch = classic_latch(NodeId::Tool, 0).unwrap();
     node.on_frame(Tick(1), latch.id(), latch.data()).unwrap();
     let first = node.release_token();
-    // An operator released (the frame still on its way) and another latched meanwhile.
+    // The same source repeating its latch (a teleop does until confirmed) keeps the token.
+    node.on_frame(Tick(2), latch.id(), latch.data()).unwrap();
+    assert_eq!(node.release_token(), first);
+    // An operator released (the frame still on its way) and another source latched meanwhile.
     let mut tool = Sender::new();
     let release = seal(
         &mut tool,
         &AnyMessage::EStop(EStop::release(NodeId::Tool, first)),
     );
-    node.on_frame(Tick(2), latch.id(), latch.data()).unwrap();
-    assert_ne!(node.release_token(), first, "every latch takes a new token");
+    let panel = classic_latch(NodeId::Teleop, 0).unwrap();
+    node.on_frame(Tick(2), panel.id(), panel.data()).unwrap();
+    assert_ne!(
+        node.release_token(),
+        first,
+        "another source's latch takes a new token"
+    );
     assert_eq!(
         node.on_frame(Tick(3), release.id(), release.data()),
         Err(DecodeError::StaleRelease { id: 0x000 })

@@ -58,6 +58,8 @@ pub struct Node {
     controller: Controller,
     sender: Sender,
     release_token: ReleaseToken,
+    /// The source of the last latch accepted while latched.
+    latch_source: Option<NodeId>,
     announced: bool,
     /// Ticks the session has run (only ever counted forward) and the tick they were counted to.
     session_ticks: u32,
@@ -89,6 +91,7 @@ impl Node {
             release_token: ReleaseToken::new(
                 session.epoch().map_or(0, |e| (e.raw() & 0xFFFF) as u16),
             ),
+            latch_source: None,
             announced: false,
             session_ticks: 0,
             counted_to: None,
@@ -219,17 +222,25 @@ impl Node {
         error
     }
 
-    /// Hands an accepted message to the controller. Every accepted latch gets a new release
-    /// token, a latch while latched included: a release sent before it answers an older latch
-    /// and is refused, so a later E-stop is never undone by an earlier release.
+    /// Hands an accepted message to the controller. A latch that latches the E-stop gets a new
+    /// release token, and so does a latch from another source while latched (a second
+    /// operator, a panel): a release sent before it answers the older latch and is refused, so
+    /// a later E-stop is never undone by an earlier release. A source repeating its own latch
+    /// (the teleop does until the controller confirms it) keeps the token; the teleop drops
+    /// its own pending release when it latches again.
     fn act(&mut self, now: Tick, message: &AnyMessage) {
+        let latched_before = self.estop_latched();
         self.controller.on_message(now, message);
         if let AnyMessage::EStop(EStop {
             action: EStopAction::Latch,
+            source,
             ..
         }) = message
         {
-            self.release_token = self.release_token.next();
+            if !latched_before || self.latch_source != Some(*source) {
+                self.release_token = self.release_token.next();
+            }
+            self.latch_source = Some(*source);
         }
     }
 
