@@ -9,7 +9,9 @@
 //! 4. the legs' targets move toward the goal with the report's smoothing;
 //! 5. every output is clamped to the joint and torque limits and made finite.
 
-use protocol::{AnyMessage, DriveFlags, EStopAction, FaultFlags, Joints, Leg, PerDrive};
+mod status;
+
+use protocol::{AnyMessage, DriveFlags, EStopAction, Joints, Leg, PerDrive};
 
 use crate::config::Config;
 use crate::control::fsm::{Direction, Event, LegMotion, State, WheelMotion};
@@ -123,7 +125,7 @@ impl Controller {
     ///
     /// When the link becomes degraded the controller stops once, as for a lost operator
     /// ([`Event::LinkDegraded`]: a trot stands still on four legs, a wheel drive brakes to a
-    /// standstill while balancing), and reports [`FaultFlags::LINK_DEGRADED`]. While it stays
+    /// standstill while balancing), and reports [`FaultFlags::LINK_DEGRADED`](protocol::FaultFlags::LINK_DEGRADED). While it stays
     /// degraded, operator requests other than Stop are refused — they are still taken as the
     /// operator's last key, so a teleop that keeps resending its mode neither restarts the
     /// motion now nor when the link recovers; after recovery the next new key acts.
@@ -136,7 +138,7 @@ impl Controller {
 
     /// Tells the controller that this tick did not come after the previous one (`stalled`): in
     /// lockstep the tick is the simulator's SYNC, and a SYNC whose tick froze or went back would
-    /// freeze every watchdog. The controller faults ([`FaultFlags::SYNC_LOST`]) and stays in
+    /// freeze every watchdog. The controller faults ([`FaultFlags::SYNC_LOST`](protocol::FaultFlags::SYNC_LOST)) and stays in
     /// `Fault` until the ticks advance again and the operator sends STOP.
     pub fn set_clock_stalled(&mut self, stalled: bool) {
         if stalled && !self.clock_stalled {
@@ -250,56 +252,6 @@ impl Controller {
             wheel_torque_nm,
             status: self.status(now, depth_m),
         }
-    }
-
-    fn status(&self, now: Tick, depth_m: f32) -> Status {
-        let mut faults = self.fault_causes(now);
-        if self.state == State::EStop {
-            faults = faults.with(FaultFlags::ESTOP_LATCHED);
-        }
-        if self.teleop.stale(now) {
-            faults = faults.with(FaultFlags::TELEOP_TIMEOUT);
-        }
-        if self.non_finite {
-            faults = faults.with(FaultFlags::NON_FINITE);
-        }
-        if self.link_degraded {
-            faults = faults.with(FaultFlags::LINK_DEGRADED);
-        }
-        if self.teleop.interlocked() {
-            faults = faults.with(FaultFlags::AWAITING_STOP);
-        }
-        let attitude = self.sensors.attitude;
-        Status {
-            mode: self.state.mode(),
-            faults,
-            tick: now,
-            body_height_m: depth_m - self.config.posture.depth_nominal_m,
-            pitch_rad: attitude.pitch_rad,
-            roll_rad: attitude.roll_rad,
-            ik_failures: self.ik_failures,
-        }
-    }
-
-    /// Causes that keep (or would put) the robot in `Fault`.
-    fn fault_causes(&self, now: Tick) -> FaultFlags {
-        let mut faults = FaultFlags::EMPTY;
-        if self.sensors.drives_stale(now) {
-            faults = faults.with(FaultFlags::FEEDBACK_TIMEOUT);
-        }
-        if self.sensors.imu_stale(now) {
-            faults = faults.with(FaultFlags::IMU_TIMEOUT);
-        }
-        if self.tilted {
-            faults = faults.with(FaultFlags::TILT_LIMIT);
-        }
-        if self.drive_faults.iter().any(|&faulted| faulted) {
-            faults = faults.with(FaultFlags::DRIVE_FAULT);
-        }
-        if self.clock_stalled {
-            faults = faults.with(FaultFlags::SYNC_LOST);
-        }
-        faults
     }
 
     fn supervise(&mut self, now: Tick) {
