@@ -6,7 +6,10 @@ use std::io::ErrorKind;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use socketcan::{CanAnyFrame, CanFdFrame, CanFdSocket, EmbeddedFrame, Id, Socket, StandardId};
+use socketcan::{
+    CanAnyFrame, CanFdFrame, CanFdSocket, CanFilter, EmbeddedFrame, Id, Socket, SocketOptions,
+    StandardId,
+};
 
 use protocol::Frame;
 
@@ -54,6 +57,24 @@ impl SocketCanBus {
             ifname: ifname.to_owned(),
             foreign: 0,
         })
+    }
+
+    /// This node, hearing only the standard identifiers `ids` (the kernel drops the rest before
+    /// they reach the socket): for a node that sends much and listens to little, such as the
+    /// scripted operator inside `sim-host`, which needs only the controller's announcement and
+    /// status and would otherwise read every frame of the bus each cycle.
+    pub fn only(self, ids: &[u16]) -> Result<Self, BusError> {
+        /// Identifier bits, and the extended-frame and remote-request flags: an exact match
+        /// on a standard data frame.
+        const EXACT: u32 = 0xC000_07FF;
+        let filters: Vec<CanFilter> = ids
+            .iter()
+            .map(|&id| CanFilter::new(u32::from(id), EXACT))
+            .collect();
+        self.socket
+            .set_filters(&filters)
+            .map_err(|source| classify(&self.ifname, source))?;
+        Ok(self)
     }
 }
 

@@ -400,9 +400,11 @@ fn teleop_send_from_a_script_folds_the_robot_and_the_controller_stops_when_it_qu
     // simulator's own log). It says so in its next status frame: up to one status period
     // (20 ms) and a cycle's frame order (4 ms each way) later.
     let sim_log = read_candump(&out.join("bus.log"));
+    // The watchdog is fed by every operator frame, the commands too (the heartbeat goes half
+    // a period after the command, and quitting sends a STOP).
     let last_beat = sim_log
         .iter()
-        .filter(|(_, f)| f.id() == 0x201)
+        .filter(|(_, f)| f.id() == 0x201 || f.id() == 0x200)
         .map(|(t, _)| *t)
         .fold(f64::NAN, f64::max);
     let noticed = sim_log
@@ -418,7 +420,7 @@ fn teleop_send_from_a_script_folds_the_robot_and_the_controller_stops_when_it_qu
         .map(|(t, _)| *t)
         .expect("the controller never reported the lost operator");
     println!(
-        "teleop send F: {beats} heartbeats; operator lost reported {:.0} ms after the last",
+        "teleop send F: {beats} heartbeats; operator lost reported {:.0} ms after its last frame",
         (noticed - last_beat) * 1e3
     );
     assert!(

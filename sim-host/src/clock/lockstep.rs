@@ -39,7 +39,7 @@ pub fn run(
     mut peers: impl FnMut(u32) -> Result<(), RunError>,
     mut observe: impl FnMut(&Simulator, &RunStats) -> bool,
 ) -> Result<RunStats, RunError> {
-    let started = Instant::now();
+    let mut started = Instant::now();
     let mut stats = RunStats::default();
     // Cycles spent waiting to join count against the same budget, so a run without a
     // controller ends (with no cycles run) after as many reply timeouts.
@@ -55,6 +55,8 @@ pub fn run(
         )?;
         if !advanced {
             joining += 1;
+            // The run's wall time counts from the session's first cycle, not the wait for it.
+            started = Instant::now();
             continue;
         }
         recorder.row(sim.telemetry())?;
@@ -112,6 +114,10 @@ pub fn cycle(
                 recorder.frame(time_s, &frame)?;
                 sim.receive(&frame);
                 commanded |= frame.id() == MessageId::WheelCommand.raw();
+                if !joined && sim.joined() {
+                    // Joined: the first SYNC goes out next cycle; no command comes before.
+                    break;
+                }
             }
             None => break,
         }

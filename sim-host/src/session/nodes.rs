@@ -7,6 +7,7 @@ use std::rc::Rc;
 use host_can::bus::Bus;
 use host_can::inproc_bus::InprocBus;
 use host_can::socketcan_bus::SocketCanBus;
+use protocol::MessageId;
 use protocol::RejectCause;
 use protocol::{Epoch, Session, TEST_KEY};
 use teleop_core::scripted::ScriptedTeleop;
@@ -57,8 +58,12 @@ impl Nodes {
                 }
             }
             BusChoice::SocketCan(ifname) => {
+                // The scripted operator hears only the controller's announcement and status.
                 let teleop: Option<Box<dyn Bus>> = if has_teleop {
-                    Some(Box::new(SocketCanBus::open(ifname)?))
+                    Some(Box::new(SocketCanBus::open(ifname)?.only(&[
+                        MessageId::Announce.raw(),
+                        MessageId::ControllerStatus.raw(),
+                    ])?))
                 } else {
                     None
                 };
