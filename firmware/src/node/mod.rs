@@ -63,7 +63,7 @@ pub struct Node {
     announced: bool,
     /// Ticks the session has run (only ever counted forward) and the tick they were counted to.
     session_ticks: u32,
-    counted_to: Option<Tick>,
+    /// The tick the session time was last moved to.
     advanced: Option<Tick>,
     polled: Option<Tick>,
     encode_failures: u32,
@@ -94,7 +94,6 @@ impl Node {
             latch_source: None,
             announced: false,
             session_ticks: 0,
-            counted_to: None,
             advanced: None,
             polled: None,
             encode_failures: 0,
@@ -184,37 +183,32 @@ impl Node {
     }
 
     /// A new tick moves the session time (what every sender's counters start at and the
-    /// receiver places them against) by the ticks counted since the previous one.
+    /// receiver places them against) by the ticks counted since the previous one. It only
+    /// ever moves forward: a tick that goes back (a restarted simulator's SYNC in lockstep)
+    /// adds nothing, and counting resumes from it.
     fn advance(&mut self, now: Tick) {
-        if self.advanced == Some(now) {
-            return;
-        }
-        self.advanced = Some(now);
-        self.set_time(now);
-    }
-
-    /// Whether the session announcement goes out in tick `now`.
-    fn announce_due(&self, now: Tick) -> bool {
-        let hz = self.controller.config().rate.hz();
-        !self.announced || slot_of(MessageId::Announce).is_some_and(|slot| slot.sends_in(now.0, hz))
-    }
-
-    /// The session time only ever moves forward: a tick that goes back (a restarted
-    /// simulator's SYNC in lockstep) or repeats adds nothing, and counting resumes from it.
-    fn set_time(&mut self, now: Tick) {
-        if let Some(previous) = self.counted_to {
-            let ahead = now.since(previous);
-            if ahead < 1_u32 << 31_u32 {
-                self.session_ticks = self.session_ticks.saturating_add(ahead);
+        match self.advanced.replace(now) {
+            Some(previous) if previous == now => return,
+            Some(previous) => {
+                let ahead = now.since(previous);
+                if ahead < 1_u32 << 31_u32 {
+                    self.session_ticks = self.session_ticks.saturating_add(ahead);
+                }
             }
+            None => {}
         }
-        self.counted_to = Some(now);
         let ms = self
             .controller
             .config()
             .rate
             .ms_from_ticks(self.session_ticks);
         self.receiver.set_time(SessionTime::from_ms(ms));
+    }
+
+    /// Whether the session announcement goes out in tick `now`.
+    fn announce_due(&self, now: Tick) -> bool {
+        let hz = self.controller.config().rate.hz();
+        !self.announced || slot_of(MessageId::Announce).is_some_and(|slot| slot.sends_in(now.0, hz))
     }
 
     fn refuse(&mut self, error: DecodeError) -> DecodeError {
