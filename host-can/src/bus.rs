@@ -84,6 +84,13 @@ pub trait Bus {
     /// Puts `frame` on the bus.
     fn send(&mut self, frame: &Frame) -> Result<(), BusError>;
 
+    /// Puts `frames` on the bus in order, as one call where the bus can (SocketCAN:
+    /// `sendmmsg`): a node that sends a cycle's frames together wakes its peers once, not
+    /// once per frame. On an error the frames before it went out.
+    fn send_all(&mut self, frames: &[Frame]) -> Result<(), BusError> {
+        frames.iter().try_for_each(|frame| self.send(frame))
+    }
+
     /// The next frame from another node, waiting at most `timeout` (zero: do not wait). `None`
     /// when nothing arrived in time. Frames that are not CAN FD data frames with an 11-bit id
     /// (error frames, remote frames, extended ids) are skipped and counted in
@@ -110,6 +117,10 @@ pub trait Bus {
 impl<B: Bus + ?Sized> Bus for Box<B> {
     fn send(&mut self, frame: &Frame) -> Result<(), BusError> {
         (**self).send(frame)
+    }
+
+    fn send_all(&mut self, frames: &[Frame]) -> Result<(), BusError> {
+        (**self).send_all(frames)
     }
 
     fn recv(&mut self, timeout: Duration) -> Result<Option<Frame>, BusError> {

@@ -20,6 +20,7 @@ pub mod candump;
 pub mod fault_plan;
 pub mod faulty_bus;
 pub mod inproc_bus;
+pub mod kernel_frame;
 pub mod key_file;
 pub mod logging;
 pub mod port;

@@ -22,17 +22,46 @@ pub enum Wait {
     Until(Instant),
 }
 
-/// A bus as a port: `transmit` sends, `receive` waits as told.
+/// A bus as a port: `transmit` sends (or, batching, queues until [`BusPort::flush`]),
+/// `receive` waits as told.
 #[derive(Debug)]
 pub struct BusPort<'a, B: Bus + ?Sized> {
     bus: &'a mut B,
     wait: Wait,
+    outbox: Option<Vec<Frame>>,
 }
 
 impl<'a, B: Bus + ?Sized> BusPort<'a, B> {
-    /// `bus` as a port whose `receive` waits as `wait` says.
+    /// `bus` as a port whose `receive` waits as `wait` says and whose `transmit` sends at once.
     pub fn new(bus: &'a mut B, wait: Wait) -> Self {
-        Self { bus, wait }
+        Self {
+            bus,
+            wait,
+            outbox: None,
+        }
+    }
+
+    /// As [`BusPort::new`], but `transmit` queues the frames and [`BusPort::flush`] puts them
+    /// on the bus in one call ([`Bus::send_all`]): a tick's commands then wake the other
+    /// nodes once. Frames not flushed are never sent.
+    pub fn batching(bus: &'a mut B, wait: Wait) -> Self {
+        Self {
+            bus,
+            wait,
+            outbox: Some(Vec::new()),
+        }
+    }
+
+    /// Sends the queued frames, in the order they were transmitted.
+    pub fn flush(&mut self) -> Result<(), BusError> {
+        match self.outbox.as_mut() {
+            Some(outbox) if !outbox.is_empty() => {
+                let result = self.bus.send_all(outbox);
+                outbox.clear();
+                result
+            }
+            _ => Ok(()),
+        }
     }
 }
 
@@ -42,7 +71,10 @@ impl<B: Bus + ?Sized> Can for BusPort<'_, B> {
 
     /// Sends `frame`; a host bus never replaces a queued frame.
     fn transmit(&mut self, frame: &Frame) -> nb::Result<Option<Frame>, BusError> {
-        self.bus.send(frame).map_err(nb::Error::Other)?;
+        match self.outbox.as_mut() {
+            Some(outbox) => outbox.push(*frame),
+            None => self.bus.send(frame).map_err(nb::Error::Other)?,
+        }
         Ok(None)
     }
 
@@ -88,5 +120,26 @@ mod tests {
         let past = Instant::now();
         let mut port_b = BusPort::new(&mut b, Wait::Until(past));
         assert!(matches!(port_b.receive(), Err(nb::Error::WouldBlock)));
+    }
+
+    #[test]
+    fn a_batching_port_sends_on_flush_in_order() {
+        let bus = InprocBus::new();
+        let mut a = bus.endpoint();
+        let mut b = bus.endpoint();
+        let frames = [
+            Frame::new(0x10, &[1]).unwrap(),
+            Frame::new(0x20, &[2]).unwrap(),
+        ];
+        let mut port_a = BusPort::batching(&mut a, Wait::Never);
+        for frame in &frames {
+            assert!(matches!(port_a.transmit(frame), Ok(None)));
+        }
+        assert_eq!(b.recv(Duration::ZERO).unwrap(), None);
+        port_a.flush().unwrap();
+        port_a.flush().unwrap();
+        assert_eq!(b.recv(Duration::ZERO).unwrap(), Some(frames[0]));
+        assert_eq!(b.recv(Duration::ZERO).unwrap(), Some(frames[1]));
+        assert_eq!(b.recv(Duration::ZERO).unwrap(), None);
     }
 }

@@ -2,18 +2,21 @@
 //! Classic CAN data frames are accepted too (a `cansend 123#…` from a shell); error, remote and
 //! extended-id frames are counted as foreign and skipped.
 
-use std::io::ErrorKind;
 use std::path::Path;
 use std::time::{Duration, Instant};
 
-use socketcan::{
-    CanAnyFrame, CanFdFrame, CanFdSocket, CanFilter, EmbeddedFrame, Id, Socket, SocketOptions,
-    StandardId,
-};
+use std::io::IoSlice;
+use std::os::fd::{AsFd, AsRawFd, RawFd};
+
+use nix::errno::Errno;
+use nix::poll::{poll, PollFd, PollFlags, PollTimeout};
+use nix::sys::socket::{recv, sendmmsg, MsgFlags, MultiHeaders};
+use socketcan::{CanFdSocket, CanFilter, Socket, SocketOptions};
 
 use protocol::Frame;
 
 use crate::bus::{Bus, BusError};
+use crate::kernel_frame::{self, FD_BYTES};
 
 /// A node on a SocketCAN interface.
 #[derive(Debug)]
@@ -146,16 +149,21 @@ pub fn write_within(
 
 impl Bus for SocketCanBus {
     fn send(&mut self, frame: &Frame) -> Result<(), BusError> {
-        let id = StandardId::new(frame.id()).ok_or_else(|| BusError::Io {
-            ifname: self.ifname.clone(),
-            source: std::io::Error::new(ErrorKind::InvalidInput, "not an 11-bit id"),
-        })?;
-        let fd = CanFdFrame::new(id, frame.data()).ok_or_else(|| BusError::Io {
-            ifname: self.ifname.clone(),
-            source: std::io::Error::new(ErrorKind::InvalidInput, "not a CAN FD length"),
-        })?;
-        let socket = &self.socket;
-        write_within(SEND_DEADLINE, || socket.write_frame(&fd)).map_err(|e| {
+        self.send_all(std::slice::from_ref(frame))
+    }
+
+    fn send_all(&mut self, frames: &[Frame]) -> Result<(), BusError> {
+        let records: Vec<[u8; FD_BYTES]> = frames.iter().map(kernel_frame::encode_fd).collect();
+        let fd = self.socket.as_raw_fd();
+        let mut left = records.as_slice();
+        let result = write_within(SEND_DEADLINE, || {
+            while !left.is_empty() {
+                let sent = send_batch(fd, left)?;
+                left = left.get(sent..).unwrap_or_default();
+            }
+            Ok(())
+        });
+        result.map_err(|e| {
             if e.raw_os_error() == Some(ENOBUFS) {
                 BusError::TxQueueFull {
                     ifname: self.ifname.clone(),
@@ -168,40 +176,24 @@ impl Bus for SocketCanBus {
     }
 
     fn recv(&mut self, timeout: Duration) -> Result<Option<Frame>, BusError> {
-        // One deadline for the whole call: skipping foreign frames or an interrupted read does
-        // not restart the wait, so a babbling foreign node cannot hold the caller here.
+        // One deadline for the whole call: skipping foreign frames or an interrupted wait does
+        // not restart it, so a babbling foreign node cannot hold the caller here. A frame
+        // already queued is taken without polling first (one system call, not two).
         let deadline = Instant::now() + timeout;
         loop {
-            let left = deadline.saturating_duration_since(Instant::now());
-            // poll(2) counts whole milliseconds: a shorter wait would poll with 0 and spin a
-            // core until the deadline, so it sleeps instead and then looks once.
-            let poll_for = if left < Duration::from_millis(1) {
-                if !left.is_zero() {
-                    std::thread::sleep(left);
+            match self.read_queued()? {
+                Read::Frame(frame) => return Ok(Some(frame)),
+                Read::Foreign => {
+                    self.foreign += 1;
+                    continue;
                 }
-                Duration::ZERO
-            } else {
-                left
-            };
-            let any = match self.socket.read_frame_timeout(poll_for) {
-                Ok(frame) => frame,
-                Err(e) if matches!(e.kind(), ErrorKind::TimedOut | ErrorKind::WouldBlock) => {
-                    return Ok(None)
-                }
-                Err(e) if e.kind() == ErrorKind::Interrupted && !left.is_zero() => continue,
-                Err(e) if e.kind() == ErrorKind::Interrupted => return Ok(None),
-                Err(e) => return Err(classify(&self.ifname, e)),
-            };
-            let converted = match &any {
-                CanAnyFrame::Fd(f) => standard(f.id()).and_then(|id| Frame::new(id, f.data())),
-                CanAnyFrame::Normal(f) => standard(f.id()).and_then(|id| Frame::new(id, f.data())),
-                _ => None,
-            };
-            match converted {
-                Some(frame) => return Ok(Some(frame)),
-                None => self.foreign += 1,
+                Read::Empty => {}
             }
-            if Instant::now() >= deadline {
+            let left = deadline.saturating_duration_since(Instant::now());
+            if left.is_zero() {
+                return Ok(None);
+            }
+            if !self.wait_readable(left)? {
                 return Ok(None);
             }
         }
@@ -216,11 +208,52 @@ impl Bus for SocketCanBus {
     }
 }
 
-fn standard(id: Id) -> Option<u16> {
-    match id {
-        Id::Standard(id) => Some(id.as_raw()),
-        Id::Extended(_) => None,
+/// What one non-blocking read found.
+enum Read {
+    Frame(Frame),
+    Foreign,
+    Empty,
+}
+
+impl SocketCanBus {
+    /// Takes one queued record without waiting.
+    fn read_queued(&mut self) -> Result<Read, BusError> {
+        let mut record = [0_u8; FD_BYTES];
+        match recv(self.socket.as_raw_fd(), &mut record, MsgFlags::MSG_DONTWAIT) {
+            Ok(len) => Ok(match kernel_frame::decode(&record, len) {
+                Some(frame) => Read::Frame(frame),
+                None => Read::Foreign,
+            }),
+            Err(Errno::EAGAIN | Errno::EINTR) => Ok(Read::Empty),
+            Err(errno) => Err(classify(&self.ifname, errno.into())),
+        }
     }
+
+    /// Waits at most `left` for a record; whether one may be there. poll(2) counts whole
+    /// milliseconds: a shorter wait would poll with 0 and spin a core until the deadline, so
+    /// it sleeps instead and then says "look once more".
+    fn wait_readable(&self, left: Duration) -> Result<bool, BusError> {
+        if left < Duration::from_millis(1) {
+            std::thread::sleep(left);
+            return Ok(true);
+        }
+        let mut fds = [PollFd::new(self.socket.as_fd(), PollFlags::POLLIN)];
+        let timeout = PollTimeout::try_from(left).unwrap_or(PollTimeout::MAX);
+        match poll(&mut fds, timeout) {
+            Ok(ready) => Ok(ready > 0),
+            Err(Errno::EINTR) => Ok(true),
+            Err(errno) => Err(classify(&self.ifname, errno.into())),
+        }
+    }
+}
+
+/// Writes `records` with one `sendmmsg`; how many the kernel took (at least one, or an error).
+fn send_batch(fd: RawFd, records: &[[u8; FD_BYTES]]) -> std::io::Result<usize> {
+    let slices: Vec<[IoSlice<'_>; 1]> = records.iter().map(|r| [IoSlice::new(r)]).collect();
+    let addresses: Vec<Option<()>> = vec![None; records.len()];
+    let mut headers = MultiHeaders::<()>::preallocate(records.len(), None);
+    let results = sendmmsg(fd, &mut headers, &slices, &addresses, [], MsgFlags::empty())?;
+    Ok(results.count())
 }
 
 #[cfg(test)]

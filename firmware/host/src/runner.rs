@@ -164,7 +164,7 @@ fn lockstep(
             }
             last_announce = Some(Instant::now());
         }
-        let mut port = BusPort::new(&mut *bus, Wait::Until(Instant::now() + LOCKSTEP_POLL));
+        let mut port = BusPort::batching(&mut *bus, Wait::Until(Instant::now() + LOCKSTEP_POLL));
         let received = service::receive(node, next, &mut port, Drain::ThroughSync, RX_LIMIT)?;
         stats.frames_in += u64::from(received.frames);
         keeper.keep(node)?;
@@ -179,6 +179,7 @@ fn lockstep(
         last_sync = Instant::now();
         let tick = Tick(sync_tick);
         let sent = service::transmit(node, tick, &mut port)?;
+        port.flush()?;
         stats.frames_out += u64::from(sent.sent);
         stats.ticks += 1;
         next = tick.plus(1);
@@ -202,11 +203,12 @@ fn wall(
     let mut slot: u64 = 0;
     while !done(&config, stats, stop) {
         slot = current_slot(slot, start.elapsed(), period, &mut stats.overruns);
-        let mut port = BusPort::new(&mut *bus, Wait::Never);
+        let mut port = BusPort::batching(&mut *bus, Wait::Never);
         let received = service::receive(node, tick, &mut port, Drain::All, RX_LIMIT)?;
         stats.frames_in += u64::from(received.frames);
         keeper.keep(node)?;
         let sent = service::transmit(node, tick, &mut port)?;
+        port.flush()?;
         stats.frames_out += u64::from(sent.sent);
         stats.ticks += 1;
         tick = tick.plus(1);

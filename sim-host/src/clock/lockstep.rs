@@ -94,8 +94,9 @@ pub fn cycle(
     // SYNC arrives, with this cycle's feedback already in hand.
     let mut outgoing = sim.frames_due()?;
     outgoing.extend(sim.sync_frame()?);
+    // In one call: a controller in another process wakes once for the cycle, not per frame.
+    bus.send_all(&outgoing)?;
     for frame in &outgoing {
-        bus.send(frame)?;
         recorder.frame(time_s, frame)?;
         stats.frames_sent += 1;
     }

@@ -46,9 +46,11 @@ pub fn run(
                 time_s: sim.time_s(),
             });
         }
-        for frame in sim.frames_due()? {
-            bus.send(&frame)?;
-            recorder.frame(started.elapsed().as_secs_f64(), &frame)?;
+        let outgoing = sim.frames_due()?;
+        let sent_s = started.elapsed().as_secs_f64();
+        bus.send_all(&outgoing)?;
+        for frame in &outgoing {
+            recorder.frame(sent_s, frame)?;
             stats.frames_sent += 1;
         }
         peers(sim.cycle())?;
