@@ -90,40 +90,6 @@ const fn check_comment(id: MessageId) -> &'static str {
     }
 }
 
-/// Nodes that act on a message (the DBC's receivers).
-const fn receivers(id: MessageId) -> &'static [NodeId] {
-    match id {
-        MessageId::EStop | MessageId::Announce => &[
-            NodeId::Controller,
-            NodeId::LegDriveFl,
-            NodeId::LegDriveFr,
-            NodeId::LegDriveBl,
-            NodeId::LegDriveBr,
-            NodeId::WheelDrive,
-        ],
-        MessageId::Sync => &[
-            NodeId::Controller,
-            NodeId::LegDriveFl,
-            NodeId::WheelDrive,
-            NodeId::Imu,
-        ],
-        MessageId::LegTargets => &[
-            NodeId::LegDriveFl,
-            NodeId::LegDriveFr,
-            NodeId::LegDriveBl,
-            NodeId::LegDriveBr,
-        ],
-        MessageId::WheelCommand => &[NodeId::WheelDrive],
-        MessageId::LegFeedback(_)
-        | MessageId::WheelFeedback
-        | MessageId::Imu
-        | MessageId::TeleopCommand
-        | MessageId::TeleopHeartbeat
-        | MessageId::DriveStatus(_) => &[NodeId::Controller],
-        MessageId::ControllerStatus | MessageId::RejectCounters => &[NodeId::Teleop],
-    }
-}
-
 fn write_message<W: Write>(out: &mut W, id: MessageId) -> fmt::Result {
     let layout = id.layout();
     writeln!(
@@ -134,7 +100,7 @@ fn write_message<W: Write>(out: &mut W, id: MessageId) -> fmt::Result {
         layout.wire_len,
         id.sender().name()
     )?;
-    let rx = receivers(id);
+    let rx = id.receivers();
     write_signal(
         out,
         "E2E_Check",

@@ -3,6 +3,7 @@
 //! 11-bit identifiers; a lower id wins arbitration. The blocks leave room so that a new message
 //! slots into its priority class without renumbering the bus.
 
+use crate::node::NodeId;
 use crate::node::{Drive, Leg};
 
 /// Highest 11-bit identifier.
@@ -132,6 +133,66 @@ impl MessageId {
             MessageId::DriveStatus(drive) => 14 + drive as usize,
             MessageId::RejectCounters => 19,
         }
+    }
+
+    /// The nodes that act on this message (the DBC's receivers). A node's acceptance filter
+    /// passes these identifiers and no others: the controller, say, never runs a frame that
+    /// carries one of its own identifiers through its checks.
+    pub const fn receivers(self) -> &'static [NodeId] {
+        match self {
+            MessageId::EStop => &[
+                NodeId::Controller,
+                NodeId::LegDriveFl,
+                NodeId::LegDriveFr,
+                NodeId::LegDriveBl,
+                NodeId::LegDriveBr,
+                NodeId::WheelDrive,
+            ],
+            // Every member joins the session it announces; the drives also read the status,
+            // whose mode confirms that the controller left its E-stop before they leave theirs.
+            MessageId::Announce => &[
+                NodeId::LegDriveFl,
+                NodeId::LegDriveFr,
+                NodeId::LegDriveBl,
+                NodeId::LegDriveBr,
+                NodeId::WheelDrive,
+                NodeId::Imu,
+                NodeId::Teleop,
+            ],
+            MessageId::ControllerStatus => &[
+                NodeId::LegDriveFl,
+                NodeId::LegDriveFr,
+                NodeId::LegDriveBl,
+                NodeId::LegDriveBr,
+                NodeId::WheelDrive,
+                NodeId::Teleop,
+            ],
+            MessageId::Sync => &[
+                NodeId::Controller,
+                NodeId::LegDriveFl,
+                NodeId::WheelDrive,
+                NodeId::Imu,
+            ],
+            MessageId::LegTargets => &[
+                NodeId::LegDriveFl,
+                NodeId::LegDriveFr,
+                NodeId::LegDriveBl,
+                NodeId::LegDriveBr,
+            ],
+            MessageId::WheelCommand => &[NodeId::WheelDrive],
+            MessageId::LegFeedback(_)
+            | MessageId::WheelFeedback
+            | MessageId::Imu
+            | MessageId::TeleopCommand
+            | MessageId::TeleopHeartbeat
+            | MessageId::DriveStatus(_) => &[NodeId::Controller],
+            MessageId::RejectCounters => &[NodeId::Teleop],
+        }
+    }
+
+    /// Whether `node` acts on this message.
+    pub fn heard_by(self, node: NodeId) -> bool {
+        self.receivers().contains(&node)
     }
 
     /// E2E data id mixed into the CRC: a frame moved to another identifier fails its CRC check.

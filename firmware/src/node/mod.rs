@@ -142,7 +142,8 @@ impl Node {
     }
 
     /// Takes one received frame. A rejected frame is counted and returned as the error; it
-    /// never reaches the controller.
+    /// never reaches the controller. Frames of identifiers the controller does not act on
+    /// ([`MessageId::receivers`]) are ignored, as a hardware acceptance filter would drop them.
     ///
     /// An operator command beyond this tick's budget ([`TELEOP_COMMANDS_PER_TICK`]) has passed
     /// the receiver's checks — its counter keeps the sequence in step — but is refused as
@@ -156,6 +157,12 @@ impl Node {
     /// 15 % at 250 Hz and 12 % at 1 kHz.
     pub fn on_frame(&mut self, now: Tick, raw_id: u16, data: &[u8]) -> Result<(), DecodeError> {
         self.advance(now);
+        // The acceptance filter: a frame with another node's identifier that the controller
+        // does not act on (its own, say, replayed) passes by unchecked and uncounted; the nodes
+        // that act on it check and count it.
+        if MessageId::from_raw(raw_id).is_some_and(|id| !id.heard_by(NodeId::Controller)) {
+            return Ok(());
+        }
         let accepted = self.receiver.receive(raw_id, data)?;
         if matches!(accepted.message, AnyMessage::TeleopCommand(_)) && !self.teleop_budget.take() {
             return Err(self.refuse(DecodeError::RateLimited { id: raw_id }));

@@ -280,6 +280,11 @@ impl Rig {
         Ok(())
     }
 
+    /// A listener on the bus from now on, as `candump` is: it hears every frame of every node.
+    pub fn tap(&self) -> InprocEndpoint {
+        self.bus.endpoint()
+    }
+
     /// Puts `frame` on the bus from outside, as `cansend` does.
     pub fn tool_send(&mut self, frame: &Frame) -> Result<(), RunError> {
         Ok(self.tool.send(frame)?)
