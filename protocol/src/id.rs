@@ -190,13 +190,65 @@ impl MessageId {
         }
     }
 
-    /// Whether `node` acts on this message.
-    pub fn heard_by(self, node: NodeId) -> bool {
-        self.receivers().contains(&node)
+    /// The identifiers `node` acts on, as a set: bit [`MessageId::index`] of each. For an
+    /// acceptance filter computed at build time, one mask test per frame.
+    pub const fn heard_by(node: NodeId) -> IdSet {
+        let mut bits = 0_u32;
+        let mut i = 0;
+        while i < MessageId::ALL.len() {
+            #[allow(clippy::indexing_slicing)] // i < ALL.len()
+            let id = MessageId::ALL[i];
+            let receivers = id.receivers();
+            let mut r = 0;
+            while r < receivers.len() {
+                #[allow(clippy::indexing_slicing)] // r < receivers.len()
+                if receivers[r] as u8 == node as u8 {
+                    bits |= 1_u32 << id.index();
+                }
+                r += 1;
+            }
+            i += 1;
+        }
+        IdSet(bits)
     }
 
     /// E2E data id mixed into the CRC: a frame moved to another identifier fails its CRC check.
     pub const fn data_id(self) -> u16 {
         0xC000 | self.raw()
+    }
+}
+
+/// A set of message identifiers (see [`MessageId::heard_by`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct IdSet(u32);
+
+impl IdSet {
+    /// Whether `id` is in the set.
+    pub const fn contains(self, id: MessageId) -> bool {
+        self.0 & (1_u32 << id.index()) != 0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_node_hears_exactly_the_receivers_list() {
+        for node in [NodeId::Controller, NodeId::WheelDrive, NodeId::Teleop] {
+            let heard = MessageId::heard_by(node);
+            for id in MessageId::ALL {
+                assert_eq!(
+                    heard.contains(id),
+                    id.receivers().contains(&node),
+                    "{node:?} {id:?}"
+                );
+            }
+        }
+        let controller = MessageId::heard_by(NodeId::Controller);
+        assert!(controller.contains(MessageId::Sync));
+        assert!(controller.contains(MessageId::TeleopCommand));
+        assert!(!controller.contains(MessageId::LegTargets));
+        assert!(!controller.contains(MessageId::Announce));
     }
 }

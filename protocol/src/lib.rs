@@ -113,7 +113,7 @@ pub use codec::{decode, encode, EncodeError, Message};
 pub use e2e::{Check, E2eChecker, E2eStatus, Protection};
 pub use error::{DecodeError, RejectCause};
 pub use frame::Frame;
-pub use id::{MessageId, MAX_STANDARD_ID};
+pub use id::{IdSet, MessageId, MAX_STANDARD_ID};
 pub use joints::{Joints, PerDrive};
 pub use message::{decode_frame, protection_of, AnyMessage, Decoded, Layout};
 pub use msg::*;

@@ -23,8 +23,8 @@ use heapless::Vec;
 use protocol::busload::slot_of;
 use protocol::{
     Angle, Announce, AnyMessage, BodyHeight, ControllerStatus, DecodeError, DriveEnable, EStop,
-    EStopAction, Frame, LegTargets, MessageId, NodeId, Receiver, RejectCounters, ReleaseToken,
-    Sender, Session, SessionTime, Torque, WheelCommand, WireVersion,
+    EStopAction, Frame, IdSet, LegTargets, MessageId, NodeId, Receiver, RejectCounters,
+    ReleaseToken, Sender, Session, SessionTime, Torque, WheelCommand, WireVersion,
 };
 
 use crate::config::Config;
@@ -34,6 +34,8 @@ use crate::time::Tick;
 use link::LinkMonitor;
 use rate_limit::TickBudget;
 
+/// The identifiers the controller acts on: its acceptance filter.
+const HEARD: IdSet = MessageId::heard_by(NodeId::Controller);
 /// Most operator commands ([`MessageId::TeleopCommand`]) handed to the controller per control
 /// tick; more are refused as [`DecodeError::RateLimited`]. The teleop sends one every 20 ms and
 /// one at once when a key changes it, so a genuine operator needs at most 2 in a tick at any
@@ -160,7 +162,7 @@ impl Node {
         // The acceptance filter: a frame with another node's identifier that the controller
         // does not act on (its own, say, replayed) passes by unchecked and uncounted; the nodes
         // that act on it check and count it.
-        if MessageId::from_raw(raw_id).is_some_and(|id| !id.heard_by(NodeId::Controller)) {
+        if MessageId::from_raw(raw_id).is_some_and(|id| !HEARD.contains(id)) {
             return Ok(());
         }
         let accepted = self.receiver.receive(raw_id, data)?;
