@@ -18,6 +18,7 @@ mod mutants;
 mod pil;
 mod same_run;
 mod setup;
+mod soak;
 mod test;
 mod util;
 
@@ -65,6 +66,9 @@ Tasks:
   mutants [FILE…]    mutation testing (cargo-mutants, installed if missing) of the
                      safety-critical modules: fails on a mutant no test kills (long: minutes per
                      file; not part of `test`)
+  soak [--minutes N] sim-host in-process for N simulated minutes (default 1440: a day), every
+                     output on (streamed to /dev/null), turning in place; fails if its resident
+                     memory grows more than 5 MB after minute 5 (`test` runs 10 minutes)
   same-run REV       proof that behaviour did not change: builds sim-host at git revision REV
                      and from the working tree, runs every shipped scenario with both, and
                      compares summary.json (all but the wall-clock fields), bus.log and
@@ -102,6 +106,7 @@ fn main() -> ExitCode {
         "faults" => faults::run(rest),
         "same-run" => same_run::run(rest),
         "mutants" => mutants::run(rest),
+        "soak" => soak::run(rest),
         "help" | "-h" | "--help" => {
             print!("{HELP}");
             Ok(())

@@ -75,6 +75,8 @@ pub fn run() -> Result<(), String> {
     crate::pil::run(&[])?;
     // A minute of libFuzzer per target from the committed seeds (the long run is documented).
     crate::fuzz::run(&["--seconds".to_string(), "60".to_string()])?;
+    // Ten simulated minutes of the soak (the day is `cargo xtask soak`).
+    crate::soak::run(&["--minutes".to_string(), "10".to_string()])?;
     crate::hil::run(&[])?;
     eprintln!("test: all checks passed");
     Ok(())

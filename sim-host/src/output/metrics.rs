@@ -4,6 +4,7 @@
 
 use serde::Serialize;
 
+use crate::output::decimated::Decimated;
 use crate::session::simulator::Simulator;
 
 /// A joint counts as past its limit beyond this, rad (MuJoCo's limits are soft constraints:
@@ -125,8 +126,9 @@ pub struct SegmentTracker {
     start_bus: BusCounters,
     limits: [(f64, f64); 4],
     wheel_limit_nm: f64,
-    /// (time s, x m, y m, unwrapped yaw deg) of every cycle.
-    track: Vec<(f64, f64, f64, f64)>,
+    /// (time s, x m, y m, unwrapped yaw deg) of every cycle (of fewer in a segment longer
+    /// than 4.4 simulated minutes: bounded memory).
+    track: Decimated<(f64, f64, f64, f64)>,
 }
 
 impl SegmentTracker {
@@ -175,7 +177,7 @@ impl SegmentTracker {
             start_bus: bus,
             limits,
             wheel_limit_nm: f64::from(config.wheel_torque_limit_nm),
-            track: Vec::new(),
+            track: Decimated::default(),
         }
     }
 
@@ -246,16 +248,16 @@ impl SegmentTracker {
     /// The segment's figures.
     pub fn finish(mut self) -> SegmentSummary {
         let start_s = self.summary.start_s;
-        if let Some(&(_, x1, y1, _)) = self.track.iter().find(|(t, ..)| *t >= start_s + 1.0) {
-            self.summary.moved_after_1s_m = self
-                .track
+        let track = std::mem::take(&mut self.track).into_vec();
+        if let Some(&(_, x1, y1, _)) = track.iter().find(|(t, ..)| *t >= start_s + 1.0) {
+            self.summary.moved_after_1s_m = track
                 .iter()
                 .filter(|(t, ..)| *t >= start_s + 1.0)
                 .map(|(_, x, y, _)| (x - x1).hypot(y - y1))
                 .fold(0.0, f64::max);
         }
-        if let Some(&(end_s, x, y, yaw)) = self.track.last() {
-            let left = self.track.iter().rev().find(|(_, tx, ty, tyaw)| {
+        if let Some(&(end_s, x, y, yaw)) = track.last() {
+            let left = track.iter().rev().find(|(_, tx, ty, tyaw)| {
                 (tx - x).hypot(ty - y) > STOPPED_RADIUS_M || (tyaw - yaw).abs() > STOPPED_YAW_DEG
             });
             self.summary.settled_after_s = match left {

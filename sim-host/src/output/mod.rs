@@ -3,6 +3,7 @@
 //! [`summary`]), the [`plots`], rendered frames ([`render`], feature `renderer`) and the
 //! interactive [`viewer`] (feature `viewer`); [`output_error`] names the file that failed.
 
+pub mod decimated;
 pub mod metrics;
 pub mod output_error;
 pub mod plots;

@@ -13,6 +13,7 @@ use std::time::{Duration, Instant};
 
 use protocol::Frame;
 
+use crate::output::decimated::Decimated;
 use crate::output::output_error::OutputError;
 use crate::output::telemetry::TelemetryRow;
 use crate::output::telemetry_csv::CsvWriter;
@@ -24,7 +25,7 @@ pub const FLUSH_EVERY: Duration = Duration::from_secs(1);
 /// The recorder of one run.
 #[derive(Debug, Default)]
 pub struct Recorder {
-    rows: Vec<TelemetryRow>,
+    rows: Decimated<TelemetryRow>,
     candump: Option<(PathBuf, CandumpWriter<BufWriter<File>>)>,
     csv: Option<CsvWriter>,
     last_flush: Option<Instant>,
@@ -92,8 +93,8 @@ impl Recorder {
         Ok(())
     }
 
-    /// Keeps one telemetry row (and writes it to the CSV file); once a second, flushes the
-    /// logs to disk.
+    /// Keeps one telemetry row in bounded memory, for the plots (and writes it to the CSV file);
+    /// once a second, flushes the logs to disk.
     pub fn row(&mut self, row: TelemetryRow) -> Result<(), OutputError> {
         if let Some(csv) = &mut self.csv {
             csv.write(&row)?;
@@ -125,9 +126,10 @@ impl Recorder {
         Ok(())
     }
 
-    /// The rows so far.
+    /// The rows kept so far (every one for 4.4 simulated minutes at 250 Hz, then fewer: see
+    /// [`Decimated`]).
     pub fn rows(&self) -> &[TelemetryRow] {
-        &self.rows
+        self.rows.kept()
     }
 
     /// Frames logged so far.
@@ -145,6 +147,6 @@ impl Recorder {
                 .finish()
                 .map_err(|source| OutputError::Io { path, source })?;
         }
-        Ok(self.rows)
+        Ok(self.rows.into_vec())
     }
 }
