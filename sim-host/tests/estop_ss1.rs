@@ -15,15 +15,6 @@ use sim_host::faults::rig::{Rig, PERIOD_US};
 use sim_host::robot::model::DEFAULT_MODEL;
 use teleop_core::scripted::PlanStep;
 
-fn step(at_s: f64, mode: TeleopMode) -> PlanStep {
-    PlanStep {
-        at_us: (at_s * 1e6).round() as u64,
-        mode,
-        body_height_m: 0.0,
-        speed_scale_pct: 100.0,
-    }
-}
-
 /// What one E-stop did, from the latch on.
 #[derive(Debug, Default)]
 struct Figures {
@@ -136,8 +127,8 @@ fn assert_stopped_within_the_deadline(what: &str, f: &Figures) {
 fn an_e_stop_at_top_speed_on_the_wheels_brakes_to_rest_and_sets_the_robot_down() {
     // Fold, W at full speed scale (4 rad/s: 0.48 m/s), steady from about 3 s; latch at 6 s.
     let plan = vec![
-        step(0.0, TeleopMode::Fold),
-        step(1.5, TeleopMode::WheelForward),
+        PlanStep::at(0.0, TeleopMode::Fold),
+        PlanStep::at(1.5, TeleopMode::WheelForward),
     ];
     let f = estop(plan, 6.0, 6.0 + deadline_s() + 2.5);
     println!("MEASURED E-stop on the wheels at top speed: {f:#?}");
@@ -166,7 +157,7 @@ fn assert_sat_down(what: &str, f: &Figures, descent_m_s: f64) {
 
 #[test]
 fn an_e_stop_while_trotting_sits_the_robot_down() {
-    let plan = vec![step(0.0, TeleopMode::TrotForward)];
+    let plan = vec![PlanStep::at(0.0, TeleopMode::TrotForward)];
     let f = estop(plan, 4.0, 4.0 + deadline_s() + 2.5);
     println!("MEASURED E-stop while trotting: {f:#?}");
     assert_sat_down("trot", &f, 0.35);
@@ -174,7 +165,7 @@ fn an_e_stop_while_trotting_sits_the_robot_down() {
 
 #[test]
 fn an_e_stop_while_standing_sits_the_robot_down() {
-    let plan = vec![step(0.0, TeleopMode::Stand)];
+    let plan = vec![PlanStep::at(0.0, TeleopMode::Stand)];
     let f = estop(plan, 2.0, 2.0 + deadline_s() + 2.5);
     println!("MEASURED E-stop while standing: {f:#?}");
     assert_sat_down("stand", &f, 0.6);

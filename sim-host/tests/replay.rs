@@ -30,15 +30,6 @@ use sim_host::faults::rig::{Rig, RIG_EPOCH};
 use sim_host::robot::model::DEFAULT_MODEL;
 use teleop_core::scripted::PlanStep;
 
-fn step(at_s: f64, mode: TeleopMode) -> PlanStep {
-    PlanStep {
-        at_us: (at_s * 1e6).round() as u64,
-        mode,
-        body_height_m: 0.0,
-        speed_scale_pct: 100.0,
-    }
-}
-
 fn latch() -> Frame {
     AnyMessage::EStop(EStop::latch(NodeId::Tool))
         .encode(&Session::unjoined(TEST_KEY), 0)
@@ -80,11 +71,11 @@ fn consumers(frame: &Frame) -> (u64, u64) {
 /// from 6.6 s. Returns the rig, still running, and the log as read back from its text.
 fn record() -> (Rig, Vec<LoggedFrame>) {
     let plan = vec![
-        step(0.0, TeleopMode::Stop),
-        step(0.2, TeleopMode::WheelForward),
-        step(4.2, TeleopMode::Stop),
-        step(4.5, TeleopMode::WheelForward),
-        step(6.6, TeleopMode::Stop),
+        PlanStep::at(0.0, TeleopMode::Stop),
+        PlanStep::at(0.2, TeleopMode::WheelForward),
+        PlanStep::at(4.2, TeleopMode::Stop),
+        PlanStep::at(4.5, TeleopMode::WheelForward),
+        PlanStep::at(6.6, TeleopMode::Stop),
     ];
     let clean = Faults::default();
     let mut rig = Rig::new(DEFAULT_MODEL.as_ref(), plan, &clean, &clean).unwrap();
@@ -93,7 +84,7 @@ fn record() -> (Rig, Vec<LoggedFrame>) {
     let mut events = [(3.0, true), (4.0, false), (5.5, true), (6.5, false)].into_iter();
     let mut next = events.next();
     while rig.time_s() < 8.0 {
-        if let Some((at_s, latching)) = next.filter(|(at_s, _)| rig.time_s() >= *at_s) {
+        if let Some((_, latching)) = next.filter(|(at_s, _)| rig.time_s() >= *at_s) {
             let frame = if latching {
                 latch()
             } else {
@@ -101,7 +92,6 @@ fn record() -> (Rig, Vec<LoggedFrame>) {
             };
             rig.tool_send(&frame).unwrap();
             next = events.next();
-            let _ = at_s;
         }
         rig.step().unwrap();
         drain(&mut tap, rig.time_s(), &mut log);

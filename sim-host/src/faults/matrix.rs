@@ -69,12 +69,7 @@ impl Motion {
 }
 
 pub(super) fn step(at_s: f64, mode: TeleopMode) -> PlanStep {
-    PlanStep {
-        at_us: (at_s * 1e6).round() as u64,
-        mode,
-        body_height_m: 0.0,
-        speed_scale_pct: 100.0,
-    }
+    PlanStep::at(at_s, mode)
 }
 
 /// How long a motion cell runs, s.

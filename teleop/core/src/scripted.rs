@@ -33,6 +33,19 @@ pub struct PlanStep {
     pub speed_scale_pct: f32,
 }
 
+impl PlanStep {
+    /// `mode` from `at_s` seconds on (rounded to the microsecond), at the neutral body height
+    /// and full speed: the step of the report's keys.
+    pub fn at(at_s: f64, mode: TeleopMode) -> Self {
+        Self {
+            at_us: (at_s * 1e6).round() as u64,
+            mode,
+            body_height_m: 0.0,
+            speed_scale_pct: 100.0,
+        }
+    }
+}
+
 /// The scripted operator.
 #[derive(Debug, Clone)]
 pub struct ScriptedTeleop {

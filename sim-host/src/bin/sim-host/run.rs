@@ -133,12 +133,7 @@ fn parse_step(text: &str) -> Result<PlanStep, String> {
     }
     let mode = teleop_core::scenario::parse_mode(mode)
         .ok_or_else(|| format!("`{mode}`: use W S A L K X, stand or fold"))?;
-    Ok(PlanStep {
-        at_us: (seconds * 1e6).round() as u64,
-        mode,
-        body_height_m: 0.0,
-        speed_scale_pct: 100.0,
-    })
+    Ok(PlanStep::at(seconds, mode))
 }
 
 /// A number within `range`, or a message naming the text and the range.
