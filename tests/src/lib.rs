@@ -91,6 +91,23 @@ impl Vcan {
         bus
     }
 
+    /// Puts a token-bucket qdisc on the interface's transmit queue that passes `rate` (a `tc`
+    /// rate, e.g. `8kbit`): a sender faster than that finds the queue full (`ENOBUFS`), as on a
+    /// bus that is off or saturated. Panics with what to do when `tc` or `sch_tbf` is missing.
+    pub fn starve(&self, rate: &str) {
+        let out = Command::new("tc")
+            .args(["qdisc", "add", "dev", &self.name, "root", "tbf"])
+            .args(["rate", rate, "burst", "1600", "latency", "20ms"])
+            .output()
+            .unwrap_or_else(|e| panic!("cannot run `tc` (iproute2): {e}"));
+        assert!(
+            out.status.success(),
+            "cannot starve {} with a tbf qdisc: {} (needs the kernel's sch_tbf module)",
+            self.name,
+            String::from_utf8_lossy(&out.stderr).trim()
+        );
+    }
+
     /// The interface name.
     pub fn name(&self) -> &str {
         &self.name
@@ -161,6 +178,31 @@ impl Process {
         self.child
             .wait()
             .unwrap_or_else(|e| panic!("{}: {e}", self.name))
+    }
+
+    /// Whether the process is still running.
+    pub fn running(&mut self) -> bool {
+        matches!(self.child.try_wait(), Ok(None))
+    }
+
+    /// Presses Ctrl-C (SIGINT) and waits for the process to exit, at most 5 s (then kills
+    /// it): its exit status, `None` if it had to be killed, and how long it took to exit.
+    pub fn interrupt(mut self) -> (Option<std::process::ExitStatus>, Duration) {
+        let _ = Command::new("kill")
+            .args(["-INT", &self.child.id().to_string()])
+            .status();
+        let started = Instant::now();
+        loop {
+            if let Ok(Some(status)) = self.child.try_wait() {
+                return (Some(status), started.elapsed());
+            }
+            if started.elapsed() > Duration::from_secs(5) {
+                let _ = self.child.kill();
+                let _ = self.child.wait();
+                return (None, started.elapsed());
+            }
+            std::thread::sleep(Duration::from_millis(5));
+        }
     }
 
     /// Asks the process to stop (SIGTERM) and waits for it.

@@ -24,14 +24,17 @@ const PACKAGES: [&str; 5] = [
     "iproute2",
 ];
 /// The kernel modules, in load order.
-const MODULES: [&str; 4] = [
+const MODULES: [&str; 5] = [
     "net/can/can.ko",
     "net/can/can-raw.ko",
     "drivers/net/can/dev/can-dev.ko",
     "drivers/net/can/vcan.ko",
+    // A token-bucket qdisc starves a vcan's transmit queue (`ENOBUFS`), as a bus-off or an
+    // overloaded controller does.
+    "net/sched/sch_tbf.ko",
 ];
 /// Programs copied into the VM from the host's PATH.
-const TOOLS: [&str; 4] = ["ip", "candump", "cansend", "canplayer"];
+const TOOLS: [&str; 5] = ["ip", "tc", "candump", "cansend", "canplayer"];
 /// The test `--speed-goal` runs.
 const SPEED_TEST: &str = "lockstep_over_vcan";
 /// The line the VM prints last: `HIL-EXIT <status>`.
