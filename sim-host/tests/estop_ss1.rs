@@ -145,9 +145,9 @@ fn an_e_stop_at_top_speed_on_the_wheels_brakes_to_rest_and_sets_the_robot_down()
 
 /// The sit-down from the legs: torque-free by the deadline, no fall, resting on the kickstand
 /// (the torso does not move when the torque goes). The torso's descent under power is held to
-/// what the sequence reaches, not to the 0.3 m/s asked for: the front legs' sweep into their
-/// stops lifts the robot onto its feet and sets it back down (see `firmware::control::stop`),
-/// measured 0.32 m/s from a trot and 0.58 m/s from a stand.
+/// 0.3 m/s from a trot (measured 0.25 m/s); from a stand, to what the sequence reaches, not to
+/// the 0.3 m/s asked for: the legs' sweep into their stops loses the feet's support for a moment
+/// (see `firmware::control::stop`), measured 0.58 m/s.
 fn assert_sat_down(what: &str, f: &Figures, descent_m_s: f64) {
     assert_stopped_within_the_deadline(what, f);
     assert!(f.max_drop_before_off_m_s <= descent_m_s, "{what}: {f:#?}");
@@ -160,7 +160,7 @@ fn an_e_stop_while_trotting_sits_the_robot_down() {
     let plan = vec![PlanStep::at(0.0, TeleopMode::TrotForward)];
     let f = estop(plan, 4.0, 4.0 + deadline_s() + 2.5);
     println!("MEASURED E-stop while trotting: {f:#?}");
-    assert_sat_down("trot", &f, 0.35);
+    assert_sat_down("trot", &f, 0.3);
 }
 
 #[test]
