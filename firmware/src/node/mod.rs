@@ -16,6 +16,7 @@
 //! targets at up to 250 Hz, status at 50 Hz, the reject counters at 10 Hz.
 
 pub mod link;
+pub mod persist;
 pub mod rate_limit;
 pub mod service;
 

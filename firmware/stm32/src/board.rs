@@ -3,6 +3,7 @@
 use core::panic::PanicInfo;
 
 use cortex_m_rt::entry;
+use firmware::node::persist::Memory;
 use firmware::node::service::{self, Drain};
 use firmware::{Config, Node, Tick};
 use stm32g4xx_hal::can::CanExt;
@@ -14,6 +15,7 @@ use stm32g4xx_hal::rcc::{
 };
 use stm32g4xx_hal::time::RateExtU32;
 
+use crate::flash::BoardFlash;
 use crate::port::FdcanPort;
 use crate::timer::ControlTimer;
 
@@ -67,11 +69,6 @@ const fn hex_digit(c: u8) -> Option<u8> {
     }
 }
 
-/// The session epoch of this start. The board does not yet keep its epoch in a backup
-/// register, so every start opens epoch 1 and a recording of an earlier start is fresh again
-/// until it does (see `docs/mcu.md`, "Keys and epochs").
-const BOARD_EPOCH: u32 = 1;
-
 /// Frames taken from the receive FIFO per pass of the loop (the FIFO holds 3).
 const RX_PER_PASS: u32 = 8;
 
@@ -109,11 +106,22 @@ fn main() -> ! {
     else {
         halt()
     };
-    let session = protocol::Session::owned(key(), protocol::Epoch::new(BOARD_EPOCH));
+    // The next epoch is written to flash before the session opens, and a latched E-stop comes
+    // back latched (`firmware::node::persist`).
+    let Some(flash) = BoardFlash::take(dp.FLASH) else {
+        halt()
+    };
+    let Ok((mut memory, remembered)) = Memory::start(flash) else {
+        halt()
+    };
+    let session = protocol::Session::owned(key(), remembered.epoch);
     let Ok(mut node) = Node::new(CONFIG, session) else {
         halt()
     };
     let mut now = Tick(0);
+    if remembered.latched {
+        node.restore_latch(now);
+    }
     loop {
         // Frames that arrive before tick `now` runs belong to it. Rejections are counted by
         // the node and reported on the bus; the port cannot fail.
@@ -121,12 +129,16 @@ fn main() -> ! {
         if timer.due() {
             let _ = service::transmit(&mut node, now, &mut port);
             now = now.plus(1);
+            // A latch change is written at once (a program takes ~0.1 ms; a page erase runs in
+            // bank 2 beside the loop). A flash that fails leaves the change unrecorded: the
+            // E-stop still acts, and the next start reads what was recorded.
+            let _ = memory.record_latch(node.estop_latched());
         }
     }
 }
 
 /// Stops here for good: the safe state of this controller is silence.
-fn halt() -> ! {
+pub(crate) fn halt() -> ! {
     silence_fdcan();
     loop {
         cortex_m::asm::wfi();

@@ -25,6 +25,8 @@
 #[cfg(target_os = "none")]
 mod board;
 #[cfg(target_os = "none")]
+mod flash;
+#[cfg(target_os = "none")]
 mod port;
 #[cfg(target_os = "none")]
 mod timer;
