@@ -139,8 +139,9 @@ fn an_e_stop_at_top_speed_on_the_wheels_brakes_to_rest_and_sets_the_robot_down()
     assert!(f.max_tilt_to_rest_deg <= 15.0, "{f:#?}");
     assert!(f.max_drop_after_off_m_s <= 0.3, "{f:#?}");
     assert!(f.final_tilt_deg <= 20.0, "{f:#?}");
-    // Under power, the front legs' sweep into the kickstand lifts the robot onto its feet and
-    // sets it back down: that descent is reported (`max_drop_before_off_m_s`), not bounded here.
+    // Under power, the front legs swing out on their way into the kickstand so that their
+    // sweep does not lift the robot off its wheels (1.17 m/s of descent without; 0.30 with).
+    assert!(f.max_drop_before_off_m_s <= 0.35, "{f:#?}");
 }
 
 /// The sit-down from the legs: torque-free by the deadline, no fall, resting on the kickstand
