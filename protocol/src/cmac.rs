@@ -115,4 +115,11 @@ mod tests {
             hex("dfa66747de9ae63030ca32611497c827")
         );
     }
+    #[test]
+    fn debug_output_names_the_key_and_shows_none_of_it() {
+        let key = CmacKey::new(&[0x2b; 16]);
+        let shown = format!("{key:?}");
+        assert_eq!(shown, "CmacKey(…)");
+        assert!(!shown.contains("2b") && !shown.contains("43"));
+    }
 }

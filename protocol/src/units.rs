@@ -251,5 +251,8 @@ wire_flags!(
         FAULT = 2 => "fault",
         /// The drive saw an E-stop and stays torque-free until it is cleared.
         ESTOP = 3 => "estop",
+        /// Since its last status the drive cut a torque to its rating (peak, torque-speed
+        /// limit or thermal foldback).
+        SATURATED = 4 => "saturated",
     }
 );

@@ -148,7 +148,7 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
             );
         }
         AnyMessage::DriveStatus(_, m) => {
-            for (bit, flag) in ["enabled", "timed_out", "fault", "estop"]
+            for (bit, flag) in ["enabled", "timed_out", "fault", "estop", "saturated"]
                 .iter()
                 .enumerate()
             {

@@ -12,9 +12,9 @@ use host_can::inproc_bus::InprocBus;
 use protocol::{Epoch, Session, TeleopMode, TEST_KEY};
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
-use sim_host::robot::imu::ImuNoise;
 use sim_host::robot::model::DEFAULT_MODEL;
 use sim_host::robot::physics::Physics;
+use sim_host::robot::plant::Plant;
 use sim_host::session::firmware_config;
 use sim_host::session::inproc_controller::InprocController;
 use sim_host::session::simulator::{Simulator, StartPose};
@@ -40,7 +40,7 @@ fn raw_step(c: &mut Criterion) {
 fn closed_loop(c: &mut Criterion) {
     let start = StartPose::standing();
     let mut sim =
-        Simulator::new(Path::new(DEFAULT_MODEL), 250, start, ImuNoise::default()).expect("model");
+        Simulator::new(Path::new(DEFAULT_MODEL), 250, start, Plant::default()).expect("model");
     let bus = InprocBus::new();
     let mut sim_bus = bus.endpoint();
     let mut teleop_bus = bus.endpoint();

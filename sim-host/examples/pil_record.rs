@@ -25,8 +25,8 @@ use pil_format::Recording;
 use protocol::{Epoch, Session, TeleopMode, TEST_KEY};
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
-use sim_host::robot::imu::ImuNoise;
 use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::robot::plant::Plant;
 use sim_host::session::firmware_config;
 use sim_host::session::run_stats::RunError;
 use sim_host::session::simulator::{Simulator, StartPose};
@@ -53,7 +53,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         DEFAULT_MODEL.as_ref(),
         CONTROL_HZ,
         StartPose::standing(),
-        ImuNoise::default(),
+        Plant::default(),
     )?;
     let config = firmware_config(CONTROL_HZ).ok_or("control rate")?;
     let session = Session::owned(TEST_KEY, Epoch::new(pil_format::PIL_EPOCH));

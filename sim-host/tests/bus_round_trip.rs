@@ -20,6 +20,7 @@ use sim_host::output::recorder::Recorder;
 use sim_host::robot::drive_core::{Authority, SS1_TIMER_US};
 use sim_host::robot::imu::ImuNoise;
 use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::robot::plant::Plant;
 use sim_host::session::simulator::{Simulator, StartPose};
 
 const HZ: u32 = 250;
@@ -136,7 +137,7 @@ fn setup() -> (Simulator, InprocEndpoint, Rc<RefCell<TestController>>) {
         Path::new(DEFAULT_MODEL),
         HZ,
         StartPose::standing(),
-        ImuNoise::default(),
+        Plant::default(),
     )
     .unwrap();
     let bus = InprocBus::new();
@@ -259,7 +260,7 @@ fn drives_go_torque_free_100_ms_after_the_last_command_and_say_so() {
     ctl.borrow_mut().plan = Plan::Silent;
     let mut off_at_us = None;
     run(&mut sim, &mut bus, &ctl, 100, |s| {
-        let wheels_off = s.hardware().wheel_torque_nm(s.now_us()) == [0.0; 2];
+        let wheels_off = s.hardware().wheel_torque_nm() == [0.0; 2];
         let legs_off = (0..4).all(|leg| !s.physics().leg_enabled(leg));
         if off_at_us.is_none() && wheels_off && legs_off {
             off_at_us = Some(s.now_us());
@@ -350,17 +351,24 @@ fn an_e_stop_frame_lets_the_drives_obey_for_the_ss1_timer_then_stops_them_until_
             .chain([hardware.wheel().core()])
             .map(|core| core.authority(now))
             .collect();
-        let off = authorities.iter().all(|a| *a == Authority::TorqueOff)
-            && hardware.wheel_torque_nm(now) == [0.0; 2];
+        // The torque a drive applied in the cycle's step follows its authority one cycle on.
+        let off = authorities.iter().all(|a| *a == Authority::TorqueOff);
         let on = authorities.iter().all(|a| *a == Authority::Drive)
-            && hardware.wheel_torque_nm(now) == [3.0; 2];
+            && hardware.wheel_torque_nm() == [3.0; 2];
+        let applied_off = hardware.wheel_torque_nm() == [0.0; 2];
         if n == timer_cycles / 2 {
             ctl.borrow_mut().extra = vec![estop(EStop::latch(NodeId::Tool))];
         }
         match off_from {
             None if off => off_from = Some(n),
             None => assert!(on, "cycle {n} of the timer: the drives must obey"),
-            Some(_) => assert!(off, "a drive restarted while the E-stop is latched"),
+            Some(from) => {
+                assert!(off, "a drive restarted while the E-stop is latched");
+                assert!(
+                    n == from || applied_off,
+                    "wheel torque applied after the timer"
+                );
+            }
         }
     });
     assert_eq!(
@@ -376,7 +384,7 @@ fn an_e_stop_frame_lets_the_drives_obey_for_the_ss1_timer_then_stops_them_until_
     let release = estop(EStop::release(NodeId::Tool, ReleaseToken::new(1)));
     ctl.borrow_mut().extra = vec![release];
     run(&mut sim, &mut bus, &ctl, 30, |_| {});
-    assert_eq!(sim.hardware().wheel_torque_nm(sim.now_us()), [0.0, 0.0]);
+    assert_eq!(sim.hardware().wheel_torque_nm(), [0.0, 0.0]);
     let status = |mode| {
         ctl.borrow_mut()
             .seal(AnyMessage::ControllerStatus(protocol::ControllerStatus {
@@ -392,11 +400,11 @@ fn an_e_stop_frame_lets_the_drives_obey_for_the_ss1_timer_then_stops_them_until_
     let still_latched = status(protocol::ControllerMode::EStop);
     ctl.borrow_mut().extra = vec![still_latched];
     run(&mut sim, &mut bus, &ctl, 5, |_| {});
-    assert_eq!(sim.hardware().wheel_torque_nm(sim.now_us()), [0.0, 0.0]);
+    assert_eq!(sim.hardware().wheel_torque_nm(), [0.0, 0.0]);
     let released = status(protocol::ControllerMode::Stop);
     ctl.borrow_mut().extra = vec![released];
     run(&mut sim, &mut bus, &ctl, 30, |_| {});
-    assert_eq!(sim.hardware().wheel_torque_nm(sim.now_us()), [3.0, 3.0]);
+    assert_eq!(sim.hardware().wheel_torque_nm(), [3.0, 3.0]);
     assert!((0..4).all(|leg| sim.physics().leg_enabled(leg)));
     for status in ctl.borrow().drive_status {
         assert!(!status.unwrap().flags.contains(DriveFlags::ESTOP));
@@ -423,8 +431,12 @@ fn the_imu_is_ideal_by_default_and_noisy_when_asked() {
         seed: 7,
         ..ImuNoise::default()
     };
+    let plant = Plant {
+        imu_noise: noise,
+        ..Plant::default()
+    };
     let mut sim =
-        Simulator::new(Path::new(DEFAULT_MODEL), HZ, StartPose::standing(), noise).unwrap();
+        Simulator::new(Path::new(DEFAULT_MODEL), HZ, StartPose::standing(), plant).unwrap();
     let bus_all = InprocBus::new();
     let mut sim_bus = bus_all.endpoint();
     let ctl = Rc::new(RefCell::new(TestController::new(bus_all.endpoint())));

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use sim_host::output::metrics::SegmentSummary;
-use sim_host::robot::imu::ImuNoise;
 use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::robot::plant::Plant;
 use sim_host::session::{self, BusChoice, Clock, SegmentSpec, SessionConfig};
 use teleop_core::scenario::{mode_name, Scenario};
 use teleop_core::scripted::PlanStep;
@@ -29,7 +29,7 @@ fn config(plan: Vec<PlanStep>, segments: Vec<SegmentSpec>, duration_s: f64) -> S
         control_hz: 250,
         reply_timeout: Duration::from_millis(100),
         max_speed: None,
-        imu_noise: ImuNoise::default(),
+        plant: Plant::default(),
         teleop_plan: plan,
         out_dir: None,
         plots: false,

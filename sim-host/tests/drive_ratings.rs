@@ -35,12 +35,12 @@ fn a_wheel_command_above_the_rating_is_applied_at_the_rating_and_counted() {
     };
     drive.on_frame(0, &command([300.0, -300.0], 0));
     assert_eq!(
-        drive.applied_torque_nm(1_000),
+        drive.commanded_torque_nm(),
         [WHEEL_PEAK_TORQUE_NM, -WHEEL_PEAK_TORQUE_NM]
     );
     assert_eq!(drive.clamped(), 1);
     drive.on_frame(4_000, &command([12.5, -3.0], 1));
-    assert_eq!(drive.applied_torque_nm(5_000), [12.5, -3.0]);
+    assert_eq!(drive.commanded_torque_nm(), [12.5, -3.0]);
     assert_eq!(
         drive.clamped(),
         1,

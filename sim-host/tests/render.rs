@@ -12,8 +12,8 @@ use std::num::NonZeroU32;
 use std::path::{Path, PathBuf};
 
 use sim_host::output::render::{FrameOptions, FrameRenderer, RenderError};
-use sim_host::robot::imu::ImuNoise;
 use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::robot::plant::Plant;
 use sim_host::session::simulator::{Simulator, StartPose};
 
 fn scratch(name: &str) -> PathBuf {
@@ -49,7 +49,7 @@ fn frames_of_the_standing_robot_show_the_scene_at_the_configured_size() {
         Path::new(DEFAULT_MODEL),
         250,
         StartPose::standing(),
-        ImuNoise::default(),
+        Plant::default(),
     )
     .unwrap();
 

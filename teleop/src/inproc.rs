@@ -10,7 +10,7 @@ use std::time::Duration;
 
 use host_can::inproc_bus::InprocEndpoint;
 use sim_host::output::telemetry::TelemetryRow;
-use sim_host::robot::imu::ImuNoise;
+use sim_host::robot::plant::Plant;
 use sim_host::session::{
     self, Attach, BusChoice, Clock, SessionConfig, SessionError, SessionReport,
 };
@@ -66,7 +66,7 @@ impl InprocRobot {
             control_hz: 250,
             reply_timeout: Duration::from_millis(500),
             max_speed: None,
-            imu_noise: ImuNoise::default(),
+            plant: Plant::default(),
             teleop_plan: Vec::new(),
             plots: options.out_dir.is_some(),
             out_dir: options.out_dir,

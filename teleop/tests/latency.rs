@@ -14,7 +14,7 @@ use protocol::{
 };
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
-use sim_host::robot::imu::ImuNoise;
+use sim_host::robot::plant::Plant;
 use sim_host::session::firmware_config;
 use sim_host::session::inproc_controller::InprocController;
 use sim_host::session::simulator::{Simulator, StartPose};
@@ -47,7 +47,7 @@ fn lockstep_latency(
         std::path::Path::new(sim_host::robot::model::DEFAULT_MODEL),
         250,
         StartPose::standing(),
-        ImuNoise::default(),
+        Plant::default(),
     )
     .unwrap();
     let bus = InprocBus::new();

@@ -11,15 +11,24 @@ use std::process::Command;
 
 use crate::util::{cargo, root, run as sh};
 
-/// The safety-critical modules: the receive checks, the watchdogs and clamps, the link monitor,
-/// the operator-command budget, the mode machine and the service loop.
-const FILES: [&str; 7] = [
+/// The safety-critical modules: the receive checks, the session and the sealing of frames, the
+/// CMAC, the watchdogs and clamps, the link monitor, the operator-command budget, the operator
+/// requests and the restart interlock, the mode machine, the controlled stop, the node with its
+/// acceptance filter and release token, its memory across restarts, and the service loop.
+const FILES: [&str; 14] = [
     "protocol/src/e2e.rs",
     "protocol/src/receiver.rs",
+    "protocol/src/session.rs",
+    "protocol/src/sender.rs",
+    "protocol/src/cmac.rs",
     "firmware/src/control/safety.rs",
     "firmware/src/node/link.rs",
     "firmware/src/node/rate_limit.rs",
+    "firmware/src/control/teleop.rs",
     "firmware/src/control/fsm.rs",
+    "firmware/src/control/stop.rs",
+    "firmware/src/node/mod.rs",
+    "firmware/src/node/persist.rs",
     "firmware/src/node/service.rs",
 ];
 
@@ -35,22 +44,40 @@ pub fn run(args: &[String]) -> Result<(), String> {
     };
     ensure_cargo_mutants()?;
     let out = root().join("target").join("mutants");
+    // A list left by an earlier run must not stand in for this one's.
+    let _ = std::fs::remove_dir_all(&out);
     let mut cmd = cargo();
+    // Ignored files (the fuzz corpus, caches) stay out of the copies the mutants build in.
     cmd.args([
         "mutants",
         "--no-shuffle",
         "--test-workspace=false",
+        "--gitignore=true",
         "--output",
     ])
-    .arg(&out);
+    .arg(&out)
+    // The copies hold no `.venv`: the DBC's cantools test finds Python here.
+    .env("PROTOCOL_PYTHON", crate::setup::venv_python());
     for package in ["protocol", "firmware"] {
         cmd.args(["--package", package]);
     }
     for file in &files {
         cmd.args(["--file", file]);
     }
-    // cargo-mutants exits 2 when mutants survive: the list below says which.
-    let _ = sh(&mut cmd);
+    // cargo-mutants exits 0 when every mutant was caught, 2 when some survived (the list below
+    // says which) and 3 when some made a test hang until its timeout (caught: the tests did not
+    // pass); anything else (a usage error, a failing unmutated tree) ends the task.
+    let status = cmd
+        .status()
+        .map_err(|e| format!("cannot run cargo mutants: {e}"))?;
+    match status.code() {
+        Some(0 | 2 | 3) => {}
+        other => {
+            return Err(format!(
+                "cargo mutants failed (exit {other:?}): see its output above"
+            ))
+        }
+    }
     let missed_path = out.join("mutants.out").join("missed.txt");
     let missed = std::fs::read_to_string(&missed_path).map_err(|e| {
         format!(

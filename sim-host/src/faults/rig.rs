@@ -21,7 +21,7 @@ use crate::clock::lockstep;
 use crate::output::metrics::FALLEN_TILT_DEG;
 use crate::output::recorder::Recorder;
 use crate::robot::drive_core::{Authority, DriveCore};
-use crate::robot::imu::ImuNoise;
+use crate::robot::plant::Plant;
 use crate::session::inproc_controller::InprocController;
 use crate::session::run_stats::{RunError, RunStats};
 use crate::session::simulator::{Simulator, StartPose};
@@ -107,7 +107,7 @@ impl Rig {
         faults: &Faults,
         teleop_faults: &Faults,
     ) -> Result<Self, SessionError> {
-        let sim = Simulator::new(model, RIG_HZ, StartPose::standing(), ImuNoise::default())?;
+        let sim = Simulator::new(model, RIG_HZ, StartPose::standing(), Plant::default())?;
         let bus = InprocBus::new();
         let sim_bus = FaultyBus::new(bus.endpoint(), faults);
         let firmware = firmware_config(RIG_HZ).ok_or(SessionError::ControlRate(RIG_HZ))?;
@@ -271,12 +271,7 @@ impl Rig {
     /// from tick 0) on the same bus, as when the simulator process is restarted.
     pub fn restart_simulator(&mut self) -> Result<(), SessionError> {
         // (The firmware keeps running: its counters go on.)
-        self.sim = Simulator::new(
-            &self.model,
-            RIG_HZ,
-            StartPose::standing(),
-            ImuNoise::default(),
-        )?;
+        self.sim = Simulator::new(&self.model, RIG_HZ, StartPose::standing(), Plant::default())?;
         Ok(())
     }
 

@@ -218,7 +218,7 @@ impl SegmentTracker {
         if excess > JOINT_TOLERANCE_RAD {
             s.joint_limit_violations += 1;
         }
-        let torque = sim.hardware().wheel_torque_nm(sim.now_us());
+        let torque = sim.hardware().wheel_torque_nm();
         let largest = torque.iter().fold(0.0_f64, |m, t| m.max(t.abs()));
         s.max_wheel_torque_nm = s.max_wheel_torque_nm.max(largest);
         if largest > self.wheel_limit_nm + 1e-6 {

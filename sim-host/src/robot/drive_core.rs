@@ -49,6 +49,8 @@ pub struct DriveCore {
     release_heard: bool,
     rejected: u32,
     commands: u32,
+    /// A torque was cut to the rating since the last status.
+    saturated: bool,
 }
 
 impl DriveCore {
@@ -64,7 +66,13 @@ impl DriveCore {
             release_heard: false,
             rejected: 0,
             commands: 0,
+            saturated: false,
         }
+    }
+
+    /// Notes that the drive cut a torque to its rating: the next status says so.
+    pub fn note_saturated(&mut self) {
+        self.saturated = true;
     }
 
     /// Runs a frame from the bus through the acceptance filter and the E2E checks. Returns the
@@ -165,9 +173,13 @@ impl DriveCore {
         self.link.seal(message)
     }
 
-    /// The status message: flags and counters.
-    pub fn status(&self, now_us: u64) -> DriveStatus {
+    /// The status message: flags and counters (the saturation flag covers the time since the
+    /// last status, which this one starts).
+    pub fn status(&mut self, now_us: u64) -> DriveStatus {
         let mut flags = DriveFlags::EMPTY;
+        if std::mem::take(&mut self.saturated) {
+            flags = flags.with(DriveFlags::SATURATED);
+        }
         if self.authority(now_us) == Authority::Drive {
             flags = flags.with(DriveFlags::ENABLED);
         }

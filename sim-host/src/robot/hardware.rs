@@ -11,9 +11,10 @@ use protocol::{
     MessageId,
 };
 
-use crate::robot::imu::{ImuNode, ImuNoise};
+use crate::robot::imu::ImuNode;
 use crate::robot::leg_drive::LegDrive;
 use crate::robot::physics::Physics;
+use crate::robot::plant::Plant;
 use crate::robot::wheel_drive::WheelDrive;
 
 /// The robot's CAN nodes.
@@ -30,16 +31,13 @@ impl Hardware {
     /// The nodes, sending on the schedule of a controller running at `control_hz`; each leg
     /// drive enforces its joints' `leg_range_rad`; every node joins the sessions it hears with
     /// `key`.
-    pub fn new(
-        control_hz: u32,
-        imu_noise: ImuNoise,
-        leg_range_rad: &Joints<[f64; 2]>,
-        key: Key,
-    ) -> Self {
+    pub fn new(control_hz: u32, plant: Plant, leg_range_rad: &Joints<[f64; 2]>, key: Key) -> Self {
+        let rating = plant.drives.leg_joint;
         Self {
-            legs: Leg::ALL.map(|leg| LegDrive::new(leg, *leg_range_rad.leg(leg), key)),
-            wheel: WheelDrive::new(key),
-            imu: ImuNode::new(imu_noise, key),
+            legs: Leg::ALL
+                .map(|leg| LegDrive::new(leg, *leg_range_rad.leg(leg), key).rated(rating)),
+            wheel: WheelDrive::new(key).rated(plant.drives.wheel),
+            imu: ImuNode::new(plant.imu_noise, key),
             control_hz,
             controller_mode: None,
         }
@@ -92,16 +90,21 @@ impl Hardware {
     }
 
     /// Sets the simulation's actuators from the drives' state for the next step.
-    pub fn apply(&self, now_us: u64, physics: &mut Physics) {
-        for leg in &self.legs {
+    pub fn apply(&mut self, now_us: u64, physics: &mut Physics) {
+        for leg in &mut self.legs {
             leg.apply(now_us, physics);
         }
         self.wheel.apply(now_us, physics);
     }
 
-    /// The torques the wheel drive applies now, N·m.
-    pub fn wheel_torque_nm(&self, now_us: u64) -> [f64; 2] {
-        self.wheel.applied_torque_nm(now_us)
+    /// The torques the wheel drive applied in the last step, N·m.
+    pub fn wheel_torque_nm(&self) -> [f64; 2] {
+        self.wheel.applied_torque_nm()
+    }
+
+    /// Physics steps in which some drive cut a torque to its rating, summed over the drives.
+    pub fn saturated_steps(&self) -> u64 {
+        self.legs.iter().map(LegDrive::saturated_steps).sum::<u64>() + self.wheel.saturated_steps()
     }
 
     /// The frames the nodes send in control cycle `cycle`, in priority order.

@@ -1,10 +1,13 @@
-//! One leg's drive: four position servos (the report's position actuators, kp 180/200/260/160
-//! in the model) that take their targets from the controller's `LegTargets` frame and report
-//! joint position, velocity and torque in a `LegFeedback` frame.
+//! One leg's drive: four position servos that take their targets from the controller's
+//! `LegTargets` frame, close the position loop themselves (the report's stiffness, kp
+//! 180/200/260/160 N·m/rad) on torque motors of a real rating ([`Rating::LEG_JOINT`]), and
+//! report joint position, velocity and applied torque in a `LegFeedback` frame.
 //!
 //! Like a real servo drive it enforces its own limits whatever the wire says: a target outside
 //! a joint's range (the model's `range`, the leg's mechanical stops) is clamped to it and the
-//! command counted ([`LegDrive::clamped`]).
+//! command counted ([`LegDrive::clamped`]); a torque beyond the motor's peak, its torque-speed
+//! limit or its thermal foldback is cut and the next status says so
+//! ([`protocol::DriveFlags::SATURATED`]).
 
 use protocol::{
     Angle, AnyMessage, DriveEnable, Frame, JointVelocity, Joints, Leg, LegFeedback, MessageId,
@@ -13,6 +16,11 @@ use protocol::{
 
 use crate::robot::drive_core::{Authority, DriveCore};
 use crate::robot::physics::Physics;
+use crate::robot::rating::{Limiter, Rating};
+
+/// The servos' stiffness, N·m/rad, per joint (hip abduction, hip pitch, knee, ankle): the
+/// report's position actuators.
+pub const SERVO_KP_NM_RAD: [f64; 4] = [180.0, 200.0, 260.0, 160.0];
 
 /// The emulated drive of one leg.
 #[derive(Debug, Clone)]
@@ -22,6 +30,9 @@ pub struct LegDrive {
     range_rad: [[f64; 2]; 4],
     targets_rad: [f64; 4],
     clamped: u64,
+    limiters: [Limiter; 4],
+    /// Physics steps in which a joint's torque was cut to the rating.
+    saturated_steps: u64,
 }
 
 impl LegDrive {
@@ -37,7 +48,20 @@ impl LegDrive {
             range_rad: range_rad.map(|[low, high]| [in_counts(low), in_counts(high)]),
             targets_rad: [0.0; 4],
             clamped: 0,
+            limiters: [Limiter::new(Rating::LEG_JOINT); 4],
+            saturated_steps: 0,
         }
+    }
+
+    /// The drive with its joints' motors of `rating` (default [`Rating::LEG_JOINT`]).
+    pub fn rated(mut self, rating: Rating) -> Self {
+        self.limiters = [Limiter::new(rating); 4];
+        self
+    }
+
+    /// Physics steps in which a joint's torque was cut to the rating.
+    pub fn saturated_steps(&self) -> u64 {
+        self.saturated_steps
     }
 
     /// The joint targets the servos hold (after clamping), rad.
@@ -82,15 +106,36 @@ impl LegDrive {
         }
     }
 
-    /// Drives the leg's servos in the simulation for the next step.
-    pub fn apply(&self, now_us: u64, physics: &mut Physics) {
+    /// Runs the leg's servos for the next physics step: the position loop's torque, limited
+    /// to the rating, or none when the drive is torque-off.
+    pub fn apply(&mut self, now_us: u64, physics: &mut Physics) {
         let leg = self.leg as usize;
+        let dt_s = physics.timestep_s();
         match self.core.authority(now_us) {
             Authority::Drive => {
-                physics.set_leg_targets(self.leg, &self.targets_rad);
+                let angles = *physics.leg_positions_rad().leg(self.leg);
+                let speeds = *physics.leg_velocities_rad_s().leg(self.leg);
+                let mut torques = [0.0; 4];
+                let mut saturated = false;
+                for (i, limiter) in self.limiters.iter_mut().enumerate() {
+                    let wanted = SERVO_KP_NM_RAD[i] * (self.targets_rad[i] - angles[i]);
+                    let limited = limiter.limit(wanted, speeds[i], dt_s);
+                    torques[i] = limited.torque_nm;
+                    saturated |= limited.saturated;
+                }
+                if saturated {
+                    self.saturated_steps += 1;
+                    self.core.note_saturated();
+                }
+                physics.set_leg_torques(self.leg, &torques);
                 physics.set_leg_enabled(leg, true);
             }
-            Authority::TorqueOff => physics.set_leg_enabled(leg, false),
+            Authority::TorqueOff => {
+                for limiter in &mut self.limiters {
+                    limiter.cool(dt_s);
+                }
+                physics.set_leg_enabled(leg, false);
+            }
         }
     }
 

@@ -1,6 +1,6 @@
 //! The robot: its MuJoCo [`model`] and [`physics`] (ground truth), and the hardware a real
 //! robot puts on the bus, emulated — four [`leg_drive`]s and the [`wheel_drive`] (sharing
-//! [`drive_core`]), the [`imu`], all together in [`hardware`].
+//! [`drive_core`], each at its [`rating`]), the [`imu`], all together in [`hardware`].
 
 pub mod drive_core;
 pub mod hardware;
@@ -9,4 +9,6 @@ pub mod leg_drive;
 pub mod link;
 pub mod model;
 pub mod physics;
+pub mod plant;
+pub mod rating;
 pub mod wheel_drive;

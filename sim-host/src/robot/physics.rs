@@ -128,16 +128,17 @@ impl Physics {
                 qpos[*adr] = *angle;
             }
         }
-        for (act, angle) in layout.leg_actuator.iter().zip(leg_joint_rad) {
-            self.data.ctrl_mut()[*act] = *angle;
+        for act in layout.leg_actuator.iter() {
+            self.data.ctrl_mut()[*act] = 0.0;
         }
         self.data.forward();
     }
 
-    /// Sets the position targets of `leg`'s four joints, rad (`hip1`, `hip2`, knee, ankle).
-    pub fn set_leg_targets(&mut self, leg: Leg, targets_rad: &[f64; 4]) {
-        for (act, target) in self.layout.leg_actuator.leg(leg).iter().zip(targets_rad) {
-            self.data.ctrl_mut()[*act] = *target;
+    /// Sets the torques of `leg`'s four joint motors, N·m (`hip1`, `hip2`, knee, ankle),
+    /// clamped by the model's control range.
+    pub fn set_leg_torques(&mut self, leg: Leg, torques_nm: &[f64; 4]) {
+        for (act, torque) in self.layout.leg_actuator.leg(leg).iter().zip(torques_nm) {
+            self.data.ctrl_mut()[*act] = *torque;
         }
     }
 

@@ -1,18 +1,19 @@
 //! The wheel drive: two torque-controlled motors (the report's motor actuators, gear 1) that
-//! take `WheelCommand` frames and report angle, speed and torque in `WheelFeedback`.
+//! take `WheelCommand` frames and report speed and applied torque in `WheelFeedback`.
 //!
-//! Like a real drive it enforces its rating whatever the wire says: a torque above
-//! [`WHEEL_PEAK_TORQUE_NM`] is clamped to it and the command counted ([`WheelDrive::clamped`]).
+//! Like a real drive it enforces its rating whatever the wire says: a commanded torque above
+//! the peak ([`WHEEL_PEAK_TORQUE_NM`]) is clamped to it and the command counted
+//! ([`WheelDrive::clamped`]); at speed and when hot the motors give less
+//! ([`Rating::WHEEL`]), and the next status says so ([`protocol::DriveFlags::SATURATED`]).
 
 use protocol::{AnyMessage, Frame, MessageId, Torque, WheelFeedback, WheelVelocity};
 
 use crate::robot::drive_core::{Authority, DriveCore};
 use crate::robot::physics::Physics;
+use crate::robot::rating::{Limiter, Rating};
 
-/// The wheel motors' peak torque, N·m: a hub motor of the class that carries this 40 kg robot
-/// (the controller plans with the same figure, `Config::wheel_torque_limit_nm`; the drive does
-/// not trust it to).
-pub const WHEEL_PEAK_TORQUE_NM: f64 = 30.0;
+/// The wheel motors' peak torque, N·m ([`Rating::WHEEL`]).
+pub const WHEEL_PEAK_TORQUE_NM: f64 = Rating::WHEEL.peak_torque_nm;
 
 /// The emulated wheel drive.
 #[derive(Debug, Clone)]
@@ -20,6 +21,11 @@ pub struct WheelDrive {
     core: DriveCore,
     torque_nm: [f64; 2],
     clamped: u64,
+    limiters: [Limiter; 2],
+    /// The torques applied in the last step, N·m.
+    applied_nm: [f64; 2],
+    /// Physics steps in which a wheel's torque was cut to the rating.
+    saturated_steps: u64,
 }
 
 impl WheelDrive {
@@ -29,7 +35,22 @@ impl WheelDrive {
             core: DriveCore::new(MessageId::WheelCommand, key),
             torque_nm: [0.0; 2],
             clamped: 0,
+            limiters: [Limiter::new(Rating::WHEEL); 2],
+            applied_nm: [0.0; 2],
+            saturated_steps: 0,
         }
+    }
+
+    /// The drive with motors of `rating` (default [`Rating::WHEEL`]); commands stay clamped to
+    /// [`WHEEL_PEAK_TORQUE_NM`].
+    pub fn rated(mut self, rating: Rating) -> Self {
+        self.limiters = [Limiter::new(rating); 2];
+        self
+    }
+
+    /// Physics steps in which a wheel's torque was cut to the rating.
+    pub fn saturated_steps(&self) -> u64 {
+        self.saturated_steps
     }
 }
 
@@ -59,18 +80,38 @@ impl WheelDrive {
         self.clamped
     }
 
-    /// The torques the motors apply for the next step: the command, or zero when the drive is
-    /// torque-off (timeout, E-stop, no command yet).
-    pub fn applied_torque_nm(&self, now_us: u64) -> [f64; 2] {
-        match self.core.authority(now_us) {
-            Authority::Drive => self.torque_nm,
-            Authority::TorqueOff => [0.0; 2],
-        }
+    /// The commanded torques the drive holds, clamped to the peak, N·m.
+    pub fn commanded_torque_nm(&self) -> [f64; 2] {
+        self.torque_nm
+    }
+
+    /// The torques the motors applied in the last step, N·m: the command within the rating, or
+    /// zero when the drive is torque-off (timeout, E-stop, no command yet).
+    pub fn applied_torque_nm(&self) -> [f64; 2] {
+        self.applied_nm
     }
 
     /// Drives the wheel motors in the simulation for the next step.
-    pub fn apply(&self, now_us: u64, physics: &mut Physics) {
-        physics.set_wheel_torques(self.applied_torque_nm(now_us));
+    pub fn apply(&mut self, now_us: u64, physics: &mut Physics) {
+        let dt_s = physics.timestep_s();
+        let speeds = physics.wheel_velocities_rad_s();
+        let on = self.core.authority(now_us) == Authority::Drive;
+        let mut saturated = false;
+        for (i, limiter) in self.limiters.iter_mut().enumerate() {
+            self.applied_nm[i] = if on {
+                let limited = limiter.limit(self.torque_nm[i], speeds[i], dt_s);
+                saturated |= limited.saturated;
+                limited.torque_nm
+            } else {
+                limiter.cool(dt_s);
+                0.0
+            };
+        }
+        if saturated {
+            self.saturated_steps += 1;
+            self.core.note_saturated();
+        }
+        physics.set_wheel_torques(self.applied_nm);
     }
 
     /// The feedback frame for the current state.

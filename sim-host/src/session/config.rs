@@ -12,7 +12,7 @@ use host_can::inproc_bus::InprocBus;
 use teleop_core::scripted::PlanStep;
 
 use crate::output::telemetry::TelemetryRow;
-use crate::robot::imu::ImuNoise;
+use crate::robot::plant::Plant;
 
 /// Which bus the simulator joins.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -59,7 +59,7 @@ pub struct SessionConfig {
     /// Lockstep: at most this many times real time (`None`: as fast as possible).
     pub max_speed: Option<f64>,
     /// IMU noise.
-    pub imu_noise: ImuNoise,
+    pub plant: Plant,
     /// Operator commands to send (empty: no teleop node on the bus).
     pub teleop_plan: Vec<PlanStep>,
     /// Where to write outputs (`None`: keep telemetry in memory only).

@@ -60,7 +60,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         &config.model,
         config.control_hz,
         StartPose::standing(),
-        config.imu_noise,
+        config.plant,
     )?;
     let cycles = (config.duration_s * f64::from(config.control_hz))
         .round()

@@ -10,9 +10,9 @@ use crate::robot::link::NodeLink;
 
 use crate::output::telemetry::TelemetryRow;
 use crate::robot::hardware::Hardware;
-use crate::robot::imu::ImuNoise;
 use crate::robot::model::ModelError;
 use crate::robot::physics::Physics;
+use crate::robot::plant::Plant;
 
 /// How the simulation starts.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -65,9 +65,9 @@ impl Simulator {
         model: &Path,
         control_hz: u32,
         start: StartPose,
-        imu_noise: ImuNoise,
+        plant: Plant,
     ) -> Result<Self, ModelError> {
-        Self::with_key(model, control_hz, start, imu_noise, TEST_KEY)
+        Self::with_key(model, control_hz, start, plant, TEST_KEY)
     }
 
     /// As [`Simulator::new`], every node joining the sessions it hears with `key`.
@@ -75,7 +75,7 @@ impl Simulator {
         model: &Path,
         control_hz: u32,
         start: StartPose,
-        imu_noise: ImuNoise,
+        plant: Plant,
         key: Key,
     ) -> Result<Self, ModelError> {
         let mut physics = Physics::load(model)?;
@@ -91,7 +91,7 @@ impl Simulator {
             });
         }
         physics.place(start.height_m, &start.leg_joint_rad);
-        let hardware = Hardware::new(control_hz, imu_noise, &physics.layout().leg_range_rad, key);
+        let hardware = Hardware::new(control_hz, plant, &physics.layout().leg_range_rad, key);
         Ok(Self {
             physics,
             hardware,
@@ -176,7 +176,7 @@ impl Simulator {
             torso_pos_m: torso.pos_m,
             torso_rpy_deg: torso.rpy_rad().map(f64::to_degrees),
             leg_joint_rad: self.physics.leg_positions_rad(),
-            wheel_torque_nm: self.hardware.wheel_torque_nm(self.now_us),
+            wheel_torque_nm: self.hardware.wheel_torque_nm(),
             wheel_speed_rad_s: self.physics.wheel_velocities_rad_s(),
             foot_force_n: self.physics.foot_forces_n(),
             body_contact: self.physics.ground_contacts().other,

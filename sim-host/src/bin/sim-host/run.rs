@@ -10,6 +10,7 @@ use clap::ValueEnum;
 use host_can::fault_plan::Faults;
 use sim_host::robot::imu::ImuNoise;
 use sim_host::robot::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
+use sim_host::robot::plant::{DriveRatings, Plant};
 use sim_host::session::{self, BusChoice, Clock, FrameSettings, SegmentSpec, SessionConfig};
 use teleop_core::scenario::{mode_name, Scenario};
 use teleop_core::scripted::PlanStep;
@@ -23,6 +24,15 @@ pub(crate) enum ClockArg {
     /// Steps on the wall clock at the control rate; reports real-time factor and overruns.
     #[value(alias = "realtime")]
     Wall,
+}
+
+/// What the emulated drives can deliver.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum DrivesArg {
+    /// Real parts' ratings: peak, torque-speed line, thermal foldback.
+    Rated,
+    /// No torque limit on the legs, a flat 30 N·m on the wheels (for debugging).
+    Ideal,
 }
 
 impl ClockArg {
@@ -95,6 +105,12 @@ pub(crate) struct RunArgs {
     /// Seed of the IMU noise.
     #[arg(long, default_value_t = 1)]
     pub(crate) seed: u64,
+    /// What the drives can deliver: `rated` (a quasi-direct-drive leg actuator, 33.5 N·m peak
+    /// with its torque-speed line and thermal foldback; 30 N·m hub motors) or `ideal` (the
+    /// report's unlimited leg servos, flat 30 N·m wheels). Default: `ideal`, until the
+    /// controller copes with rated drives.
+    #[arg(long, value_enum, default_value_t = DrivesArg::Ideal)]
+    pub(crate) drives: DrivesArg,
     /// Skip the PNG plots.
     #[arg(long)]
     pub(crate) no_plots: bool,
@@ -240,12 +256,18 @@ fn session_config(args: &RunArgs, scenario: Option<&Scenario>, duration_s: f64) 
         control_hz: args.control_hz,
         reply_timeout: Duration::from_millis(args.reply_timeout_ms),
         max_speed: args.pace,
-        imu_noise: ImuNoise {
-            gyro_std_rad_s: args.gyro_noise_rad_s,
-            gyro_bias_rad_s: [args.gyro_bias_rad_s; 3],
-            accel_std_m_s2: args.accel_noise_m_s2,
-            seed: args.seed,
-            ..ImuNoise::default()
+        plant: Plant {
+            imu_noise: ImuNoise {
+                gyro_std_rad_s: args.gyro_noise_rad_s,
+                gyro_bias_rad_s: [args.gyro_bias_rad_s; 3],
+                accel_std_m_s2: args.accel_noise_m_s2,
+                seed: args.seed,
+                ..ImuNoise::default()
+            },
+            drives: match args.drives {
+                DrivesArg::Rated => DriveRatings::RATED,
+                DrivesArg::Ideal => DriveRatings::IDEAL,
+            },
         },
         teleop_plan,
         attach: None,

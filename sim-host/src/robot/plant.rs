@@ -1,0 +1,50 @@
+//! What the emulated hardware is made of, for a run: the IMU's noise and the drives' ratings.
+//! The tested default is [`Plant::default`]; the ideal parts stay for debugging a controller.
+
+use crate::robot::imu::ImuNoise;
+use crate::robot::rating::Rating;
+
+/// The ratings the drives enforce.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DriveRatings {
+    /// Each leg joint's motor.
+    pub leg_joint: Rating,
+    /// Each wheel's motor.
+    pub wheel: Rating,
+}
+
+impl DriveRatings {
+    /// Real parts: [`Rating::LEG_JOINT`], [`Rating::WHEEL`].
+    pub const RATED: Self = Self {
+        leg_joint: Rating::LEG_JOINT,
+        wheel: Rating::WHEEL,
+    };
+
+    /// Legs without a torque limit (the report's position servos) and wheels with a flat 30
+    /// N·m (the controller's own limit): the plant before the drives had ratings.
+    pub const IDEAL: Self = Self {
+        leg_joint: Rating::UNLIMITED,
+        wheel: Rating::FLAT_WHEEL,
+    };
+}
+
+/// The parts of one run's emulated hardware.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plant {
+    /// What the IMU adds to the truth.
+    pub imu_noise: ImuNoise,
+    /// What the drives can deliver.
+    pub drives: DriveRatings,
+}
+
+impl Default for Plant {
+    /// The tested default. Until the controller copes with rated drives (the honest-plant
+    /// work under way), the ideal ones: with [`DriveRatings::RATED`], W from standing folds
+    /// too fast for 33.5 N·m hips, falls onto its wheels and runs away backward.
+    fn default() -> Self {
+        Self {
+            imu_noise: ImuNoise::default(),
+            drives: DriveRatings::IDEAL,
+        }
+    }
+}
