@@ -74,3 +74,41 @@ pub fn classic_latch(source: NodeId, counter: u16) -> Option<Frame> {
         .ok()?;
     Frame::new(full.id(), full.data().get(..CLASSIC_LATCH_LEN)?)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{Epoch, Millis, Receiver, TeleopHeartbeat};
+
+    fn heartbeat() -> AnyMessage {
+        AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
+            uptime: Millis::saturating_from_si(1.0),
+        })
+    }
+
+    #[test]
+    fn a_sender_whose_session_changes_key_seals_with_the_new_key() {
+        let old = Session::owned(TEST_KEY, Epoch::new(4));
+        let new = Session::owned(Key([7; 16]), Epoch::new(4));
+        let mut sender = Sender::new();
+        let first = sender.seal(&old, &heartbeat()).unwrap();
+        assert!(Receiver::owner(old)
+            .receive(first.id(), first.data())
+            .is_ok());
+        // The key cached for the old session must not seal frames of the new one.
+        let second = sender.seal(&new, &heartbeat()).unwrap();
+        assert!(Receiver::owner(new)
+            .receive(second.id(), second.data())
+            .is_ok());
+        assert!(Receiver::owner(old)
+            .receive(second.id(), second.data())
+            .is_err());
+    }
+
+    #[test]
+    fn a_key_other_than_the_test_key_shows_nothing_of_itself() {
+        assert_eq!(format!("{:?}", Key([7; 16])), "Key(…)");
+        assert_eq!(format!("{TEST_KEY:?}"), "Key(test key)");
+        assert_ne!(Key([7; 16]), TEST_KEY);
+    }
+}

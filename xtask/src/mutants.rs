@@ -34,7 +34,11 @@ const FILES: [&str; 14] = [
 
 /// Mutants that survive because no behaviour tells them apart, with the reason. Each entry is
 /// the start of the line cargo-mutants prints in `missed.txt`.
-const EQUIVALENT: [(&str, &str); 0] = [];
+const EQUIVALENT: [(&str, &str); 1] = [(
+    "protocol/src/sender.rs:57:38: replace match guard key == session.key() with false",
+    "the sender then prepares the CMAC key for every frame instead of once per key: the same \
+     frames, only slower (the guard is a cache check)",
+)];
 
 pub fn run(args: &[String]) -> Result<(), String> {
     let files: Vec<&str> = if args.is_empty() {
