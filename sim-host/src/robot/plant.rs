@@ -38,13 +38,12 @@ pub struct Plant {
 }
 
 impl Default for Plant {
-    /// The tested default. Until the controller copes with rated drives (the honest-plant
-    /// work under way), the ideal ones: with [`DriveRatings::RATED`], W from standing folds
-    /// too fast for 33.5 N·m hips, falls onto its wheels and runs away backward.
+    /// The tested default: rated drives ([`DriveRatings::RATED`]) and, for now, the IMU
+    /// without noise.
     fn default() -> Self {
         Self {
             imu_noise: ImuNoise::default(),
-            drives: DriveRatings::IDEAL,
+            drives: DriveRatings::RATED,
         }
     }
 }
