@@ -377,3 +377,67 @@ fn a_release_sent_before_a_second_latch_does_not_undo_it() {
     );
     assert_eq!(node.controller().state(), State::EStop);
 }
+
+/// The session time of the node's latest announcement among `frames`, ms.
+fn announced_ms(frames: &[protocol::Frame]) -> Option<u32> {
+    frames.iter().find_map(|frame| {
+        match decode_frame(frame.id(), frame.data()).map(|d| d.message) {
+            Ok(AnyMessage::Announce(announce)) => Some(announce.time.ms()),
+            _ => None,
+        }
+    })
+}
+
+/// Polls `node` from tick `from` for `n` ticks; the last announced session time, ms.
+fn run_ticks(node: &mut Node, from: u32, n: u32) -> u32 {
+    let mut last = None;
+    for k in 0..n {
+        let (_, frames) = node.poll(Tick(from.wrapping_add(k)));
+        last = announced_ms(&frames).or(last);
+    }
+    last.expect("announced")
+}
+
+#[test]
+fn the_session_time_follows_the_ticks_forward_only_and_across_the_u32_wrap() {
+    // 250 ticks at 250 Hz: the announcements' time reaches about one second (50 Hz: the last
+    // one a few ticks before the end).
+    let mut node = node();
+    let after_1_s = run_ticks(&mut node, 0, 250);
+    assert!((960..=1_000).contains(&after_1_s), "{after_1_s} ms");
+    // A tick that goes back (a restarted simulator's SYNC) adds nothing: the time never goes
+    // back, and counting resumes from the new tick.
+    let back = run_ticks(&mut node, 10, 250);
+    assert!(back > after_1_s, "{back} ms after {after_1_s} ms");
+    assert!(
+        (back - after_1_s) <= 1_000 + 8,
+        "{back} ms after {after_1_s} ms"
+    );
+    // A tick half the counter ahead is taken as one that went back: nothing added.
+    let ahead = run_ticks(&mut node, 10 + 250 + (1 << 31), 5);
+    assert!(ahead <= back + 5 * 4, "{ahead} ms after {back} ms");
+    // Ticks that wrap past u32::MAX count as the ticks they are.
+    let mut wrapping = common::node(Config::ROBOT);
+    let start = u32::MAX - 100;
+    let across = run_ticks(&mut wrapping, start, 250);
+    assert!(
+        (960..=1_000).contains(&across),
+        "{across} ms across the wrap"
+    );
+}
+
+#[test]
+fn a_restored_latch_starts_the_node_latched_until_a_fresh_release() {
+    let mut node = node();
+    assert!(!node.estop_latched());
+    node.restore_latch(Tick(0));
+    assert!(node.estop_latched());
+    let (output, _) = node.poll(Tick(1));
+    assert_eq!(output.status.mode, protocol::ControllerMode::EStop);
+    let (output, _) = node.poll(Tick(2));
+    assert!(output
+        .status
+        .faults
+        .contains(protocol::FaultFlags::ESTOP_LATCHED));
+    assert_eq!(node.controller().state(), State::EStop);
+}
