@@ -441,3 +441,29 @@ fn a_restored_latch_starts_the_node_latched_until_a_fresh_release() {
         .contains(protocol::FaultFlags::ESTOP_LATCHED));
     assert_eq!(node.controller().state(), State::EStop);
 }
+
+#[test]
+fn the_announcement_before_the_first_tick_and_the_status_tick_say_what_the_node_is() {
+    let mut node = node();
+    // What a lockstep runner sends while it waits for its first SYNC.
+    let frame = node.announce_frame().expect("an announcement");
+    match decode_frame(frame.id(), frame.data()).map(|d| d.message) {
+        Ok(AnyMessage::Announce(announce)) => {
+            assert_eq!(announce.version, protocol::WireVersion::THIS);
+            assert_eq!(Some(announce.epoch), node.session().epoch());
+        }
+        other => panic!("{other:?}"),
+    }
+    // The status carries the tick it was sent in.
+    let status_tick = (0..20).find_map(|tick| {
+        let (_, frames) = node.poll(Tick(1_000 + tick));
+        frames.iter().find_map(
+            |f| match decode_frame(f.id(), f.data()).map(|d| d.message) {
+                Ok(AnyMessage::ControllerStatus(status)) => Some((tick, status.tick.raw())),
+                _ => None,
+            },
+        )
+    });
+    let (tick, raw) = status_tick.expect("a status within 20 ticks");
+    assert_eq!(raw, 1_000 + tick);
+}

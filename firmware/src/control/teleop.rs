@@ -95,3 +95,38 @@ impl Teleop {
         self.watchdog.age_ticks(now)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use protocol::{BodyHeight, SpeedScale};
+
+    use super::*;
+
+    fn command(mode: TeleopMode, speed_pct: u8) -> TeleopCommand {
+        TeleopCommand {
+            mode,
+            body_height: BodyHeight::saturating_from_si(0.05),
+            speed_scale: SpeedScale::from_raw(speed_pct)
+                .unwrap_or(SpeedScale::saturating_from_si(0.0)),
+        }
+    }
+
+    #[test]
+    fn levels_apply_with_every_command_and_the_speed_is_a_fraction_of_the_full_speed() {
+        let mut teleop = Teleop::new(100);
+        assert_eq!(
+            teleop.command(Tick(0), &command(TeleopMode::Stop, 50)),
+            Some(TeleopMode::Stop)
+        );
+        assert!(
+            (teleop.speed_scale - 0.5).abs() < 1e-6,
+            "{}",
+            teleop.speed_scale
+        );
+        assert!((teleop.body_height_m - 0.05).abs() < 1e-3);
+        teleop.command(Tick(1), &command(TeleopMode::Stop, 100));
+        assert!((teleop.speed_scale - 1.0).abs() < 1e-6);
+        teleop.command(Tick(2), &command(TeleopMode::Stop, 0));
+        assert_eq!(teleop.speed_scale, 0.0);
+    }
+}
