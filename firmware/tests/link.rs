@@ -211,8 +211,7 @@ fn twenty_percent_loss_brakes_a_wheel_drive_to_a_balanced_standstill() {
     let mut bench = LossyBench::new();
     bench.run(5);
     bench.press(TeleopMode::WheelForward);
-    // The fold (down onto the wheels, then the legs tucked) takes some 3 s.
-    bench.run(ticks_from_s(4));
+    bench.run(ticks_from_s(2));
     let drive = State::Wheels(WheelMotion::Drive(Direction::Forward));
     assert_eq!(bench.state(), drive);
     bench.drop_every = Some(5);

@@ -110,12 +110,9 @@ fn in_lockstep_the_key_reaches_the_actuators_in_the_same_control_tick() {
     });
     println!("MEASURED lockstep key-to-actuator: E-stop {estop} cycles, F (fold) {fold} cycles (period 4 ms)");
     assert_eq!(estop, 0, "E-stop: the tick after the key disables the legs");
-    // The fold starts in the tick after the key, with zero joint rate (a smoothstep ramp that
-    // keeps the drives within their ratings): its first ticks move the targets by less than
-    // the wire's 1e-4 rad, so the frames show the move from the third tick.
-    assert!(
-        fold <= 3,
-        "fold: the leg targets moved {fold} ticks after the key"
+    assert_eq!(
+        fold, 0,
+        "fold: the tick after the key moves the leg targets"
     );
 }
 

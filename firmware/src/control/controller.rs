@@ -23,7 +23,6 @@ use crate::control::teleop::Teleop;
 use crate::legs::gait::Trot;
 use crate::legs::kinematics::LegJoints;
 use crate::legs::smoothing::Smoother;
-use crate::legs::transfer::{Toward, Transfer};
 use crate::time::Tick;
 use crate::wheels::balance::{Balance, BalanceInput};
 use crate::wheels::wheel::{mix, SpeedLoop};
@@ -59,14 +58,6 @@ pub struct Controller {
     ik_failures: u32,
     /// The controlled stop of the present E-stop (`None` outside `EStop`).
     stop: Option<Stop>,
-    /// The move between legs and wheels under way (`Folding`, `Standing`; `None` otherwise).
-    transfer: Option<Transfer>,
-    /// Whether that move has ended.
-    transfer_done: bool,
-    /// When the balance law took the wheels (`None` while it does not drive them).
-    wheels_since: Option<Tick>,
-    /// Whether the measured leg pose leaves the wheels on the ground, once computed this tick.
-    grounded: Option<bool>,
 }
 
 impl Controller {
@@ -96,10 +87,6 @@ impl Controller {
             clock_stalled: false,
             ik_failures: 0,
             stop: None,
-            transfer: None,
-            transfer_done: false,
-            wheels_since: None,
-            grounded: None,
         })
     }
 
@@ -203,7 +190,6 @@ impl Controller {
 
     /// Runs one control tick at `now`.
     pub fn step(&mut self, now: Tick) -> Output {
-        self.grounded = None;
         self.supervise(now);
         if !self.armed {
             self.follow_measured();
@@ -213,8 +199,7 @@ impl Controller {
         let previous = self.legs_rad;
         let mut wheel_torque_nm = [0.0; 2];
         let mut legs_enabled = self.armed;
-        let state = self.state;
-        match state {
+        match self.state {
             State::EStop => match self.stop_command(now) {
                 StopCommand::Servo(targets) => self.legs_rad = targets,
                 StopCommand::Off => {
@@ -223,20 +208,14 @@ impl Controller {
                 }
             },
             State::Hold | State::Fault => {}
-            State::Standing(_) if self.rolling() => {
+            State::Standing(motion) if self.rolling() => {
                 // Stop on the wheels first: legs that unfold under a rolling robot lift it off
                 // its wheels with its momentum still in it, and it topples (measured: driving
-                // forward at 0.48 m/s, standing up flipped it over). The legs wait.
-            }
-            State::Standing(motion) => {
+                // forward at 0.48 m/s, standing up flipped it over). The goal is set, so the
+                // transition is not taken as done, but the legs wait.
                 self.leg_goal(motion, depth_m);
-                self.transfer_step(now, Toward::Legs);
             }
-            State::Folding(_) => {
-                self.goal_rad = self.fold_rad;
-                self.transfer_step(now, Toward::Wheels);
-            }
-            State::Legs(motion) => {
+            State::Legs(motion) | State::Standing(motion) => {
                 self.leg_goal(motion, depth_m);
                 let rate = match self.state {
                     State::Legs(LegMotion::Trot(_)) => self.config.gait_rate_per_s,
@@ -244,21 +223,14 @@ impl Controller {
                 };
                 self.smooth(rate);
             }
-            State::Wheels(_) => {
+            State::Folding(_) | State::Wheels(_) => {
                 self.goal_rad = self.fold_rad;
                 self.smooth(self.config.fold_rate_per_s);
             }
         }
         if self.balancing() && self.armed && self.wheels_may_drive() {
-            let since = *self.wheels_since.get_or_insert(now);
             wheel_torque_nm = self.wheel_law(now, dt_s);
-            let ramp_ticks = self.config.rate.ticks_from_ms(300).max(1);
-            let authority = (now.since(since) as f32 / ramp_ticks as f32).min(1.0);
-            for torque in &mut wheel_torque_nm {
-                *torque *= authority;
-            }
         } else {
-            self.wheels_since = None;
             self.balance.reset();
             self.turn.reset();
         }
@@ -353,7 +325,7 @@ impl Controller {
 
     /// Whether the robot still rolls on its wheels (ground speed above 5 cm/s, or turning) while
     /// they carry it.
-    fn rolling(&mut self) -> bool {
+    fn rolling(&self) -> bool {
         let r = self.config.balance.wheel_radius_m;
         let speed_m_s = r * self.sensors.mean_wheel_rate_rad_s();
         let turn_m_s = r * self.sensors.differential_wheel_rate_rad_s();
@@ -362,41 +334,24 @@ impl Controller {
 
     /// On the wheels the balance law always runs; while folding or standing up only once the
     /// measured leg pose puts the wheels on the ground (see [`crate::legs::support`]).
-    fn wheels_may_drive(&mut self) -> bool {
-        if matches!(self.state, State::Wheels(_)) {
-            return true;
-        }
-        // The legs' kinematics cost ~700 instructions a leg on the MCU: once a tick.
-        let (config, joints) = (&self.config, &self.sensors.joint_position_rad);
-        *self
-            .grounded
-            .get_or_insert_with(|| config.support.wheels_grounded(&config.geometry, joints))
+    fn wheels_may_drive(&self) -> bool {
+        matches!(self.state, State::Wheels(_))
+            || self
+                .config
+                .support
+                .wheels_grounded(&self.config.geometry, &self.sensors.joint_position_rad)
     }
 
     /// Whether a running transition has brought every target to its pose (checked after
-    /// this tick's move, so the next tick runs the new state).
+    /// this tick's goal and smoothing, so the next tick runs the new state).
     fn transition_arrived(&self) -> bool {
         matches!(self.state, State::Standing(_) | State::Folding(_))
             && self.armed
-            && self.transfer_done
-    }
-
-    /// This tick of the move `toward` the legs or the wheels, ending in `goal_rad`: started on
-    /// the first tick of the transition from where the legs are.
-    fn transfer_step(&mut self, now: Tick, toward: Toward) {
-        let mut transfer = match self.transfer.filter(|t| t.toward() == toward) {
-            Some(running) => running,
-            None => {
-                let on_wheels = self.wheels_may_drive();
-                let (config, rate) = (self.config.transfer, self.config.rate);
-                let (from, goal) = (self.legs_rad, self.goal_rad);
-                Transfer::new(config, rate, now, toward, from, goal, on_wheels)
-            }
-        };
-        let (pose, done) = transfer.step(now);
-        self.legs_rad = pose;
-        self.transfer = Some(transfer);
-        self.transfer_done = done;
+            && self
+                .legs_rad
+                .iter()
+                .zip(&self.goal_rad)
+                .all(|(now, goal)| (goal - now).abs() <= self.config.pose_tolerance_rad)
     }
 
     fn apply(&mut self, event: Event) {
@@ -420,8 +375,6 @@ impl Controller {
         if next != State::EStop {
             self.stop = None;
         }
-        self.transfer = None;
-        self.transfer_done = false;
         self.state = next;
     }
 

@@ -62,7 +62,6 @@ use protocol::{Joints, Leg};
 
 use crate::control::safety::SS1_DEADLINE_MS;
 use crate::legs::kinematics::LegJoints;
-use crate::legs::ramp::{ramp_ticks, Ramp};
 use crate::math::deg_to_rad;
 use crate::time::{Tick, TickRate};
 
@@ -127,20 +126,49 @@ impl StopConfig {
     }
 }
 
-/// A ramp of the legs ([`Ramp`]) with the front legs swung out by a bump of abduction that is
-/// zero at both ends ([`StopConfig::kickstand_spread_rad`]; zero for the other ramps).
+/// A joint-space move from one pose to another over a whole number of ticks, with a smoothstep
+/// profile (zero joint rate at both ends; the peak rate is 1.5 times the mean), the front legs
+/// swung out by a bump of abduction that is zero at both ends.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct SpreadRamp {
-    ramp: Ramp,
+struct Ramp {
+    from: Joints<f32>,
+    to: Joints<f32>,
+    start: Tick,
+    ticks: u32,
     spread_rad: f32,
 }
 
-impl SpreadRamp {
+impl Ramp {
+    /// From `from` to `to` starting at `start`, no joint faster than `peak_rate_rad_s`.
+    fn new(
+        from: Joints<f32>,
+        to: Joints<f32>,
+        start: Tick,
+        peak_rate_rad_s: f32,
+        rate: TickRate,
+    ) -> Self {
+        Self {
+            from,
+            to,
+            start,
+            ticks: ramp_ticks(&from, &to, peak_rate_rad_s, rate),
+            spread_rad: 0.0,
+        }
+    }
+
     /// The pose at `now`, and whether the ramp is over.
     fn at(&self, now: Tick) -> (Joints<f32>, bool) {
-        let (mut pose, done) = self.ramp.at(now);
+        let elapsed = now.since(self.start);
+        if elapsed >= self.ticks {
+            return (self.to, true);
+        }
+        let s = elapsed as f32 / self.ticks as f32;
+        let blend = s * s * (3.0 - 2.0 * s);
+        let mut pose = self.from;
+        for (joint, goal) in pose.iter_mut().zip(self.to.iter()) {
+            *joint += blend * (goal - *joint);
+        }
         // Abduction is about +x: outward is positive on the left, negative on the right.
-        let s = self.ramp.progress(now);
         let spread = self.spread_rad * 4.0 * s * (1.0 - s);
         if let Some(fl) = pose.leg_mut(Leg::Fl).first_mut() {
             *fl += spread;
@@ -148,7 +176,30 @@ impl SpreadRamp {
         if let Some(fr) = pose.leg_mut(Leg::Fr).first_mut() {
             *fr -= spread;
         }
-        (pose, done)
+        (pose, false)
+    }
+}
+
+/// Ticks for a smoothstep ramp from `from` to `to` whose fastest joint peaks at
+/// `peak_rate_rad_s` (a non-finite or non-positive rate, or a non-finite pose, gives 0: jump).
+fn ramp_ticks(from: &Joints<f32>, to: &Joints<f32>, peak_rate_rad_s: f32, rate: TickRate) -> u32 {
+    let largest = from
+        .iter()
+        .zip(to.iter())
+        .map(|(a, b)| (b - a).abs())
+        .fold(0.0_f32, f32::max);
+    // Smoothstep peaks at 1.5 × the mean rate.
+    let seconds = 1.5 * largest / peak_rate_rad_s;
+    let ticks = seconds * rate.hz() as f32;
+    if !(ticks.is_finite() && ticks > 0.0) {
+        return 0;
+    }
+    // Rounded up (the cast truncates, and saturates past u32::MAX).
+    let whole = ticks as u32;
+    if (whole as f32) < ticks {
+        whole.saturating_add(1)
+    } else {
+        whole
     }
 }
 
@@ -189,10 +240,12 @@ fn kickstand_ramp(
     now: Tick,
     elapsed: u32,
     spread_rad: f32,
-) -> SpreadRamp {
-    let ticks = last_ramp_ticks(config, rate, elapsed);
-    SpreadRamp {
-        ramp: Ramp::over(from, config.kickstand(), now, ticks),
+) -> Ramp {
+    Ramp {
+        from,
+        to: config.kickstand(),
+        start: now,
+        ticks: last_ramp_ticks(config, rate, elapsed),
         spread_rad,
     }
 }
@@ -202,9 +255,9 @@ fn kickstand_ramp(
 enum Phase {
     /// On the wheels: braking to rest, balancing, legs ramping into the fold (they are there
     /// unless the latch came mid-fold).
-    Brake(SpreadRamp),
+    Brake(Ramp),
     /// Legs ramping into the kickstand pose, balancing while the wheels are on the ground.
-    Kickstand(SpreadRamp),
+    Kickstand(Ramp),
     /// Kickstand reached at this tick; balancing until the settle time has passed.
     Settle(Tick),
     /// Every drive torque-free.
@@ -258,10 +311,13 @@ impl Stop {
     ) -> Self {
         let phase = match carrier {
             Carrier::Nothing => Phase::Off,
-            Carrier::Wheels => Phase::Brake(SpreadRamp {
-                ramp: Ramp::new(legs_rad, fold_rad, now, config.fold_rate_rad_s, rate),
-                spread_rad: 0.0,
-            }),
+            Carrier::Wheels => Phase::Brake(Ramp::new(
+                legs_rad,
+                fold_rad,
+                now,
+                config.fold_rate_rad_s,
+                rate,
+            )),
             // Slowly as the deadline allows: the descent of the torso scales with it.
             // No spread: the front feet carry the robot until the wheels take it.
             Carrier::Legs => Phase::Kickstand(kickstand_ramp(&config, rate, legs_rad, now, 0, 0.0)),

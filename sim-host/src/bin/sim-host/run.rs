@@ -107,8 +107,9 @@ pub(crate) struct RunArgs {
     pub(crate) seed: u64,
     /// What the drives can deliver: `rated` (a quasi-direct-drive leg actuator, 33.5 N·m peak
     /// with its torque-speed line and thermal foldback; 30 N·m hub motors) or `ideal` (the
-    /// report's unlimited leg servos, flat 30 N·m wheels: for debugging only).
-    #[arg(long, value_enum, default_value_t = DrivesArg::Rated)]
+    /// report's unlimited leg servos, flat 30 N·m wheels). Default: `ideal`, until the
+    /// controller copes with rated drives.
+    #[arg(long, value_enum, default_value_t = DrivesArg::Ideal)]
     pub(crate) drives: DrivesArg,
     /// Skip the PNG plots.
     #[arg(long)]
