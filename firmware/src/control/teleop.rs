@@ -89,11 +89,6 @@ impl Teleop {
             false
         }
     }
-
-    /// Ticks since the operator was last heard (`None` if never).
-    pub fn age_ticks(&self, now: Tick) -> Option<u32> {
-        self.watchdog.age_ticks(now)
-    }
 }
 
 #[cfg(test)]

@@ -218,9 +218,7 @@ impl<N: Nor> Memory<N> {
         };
         // At a start, half full is full: the erase goes here, before the control loop runs.
         let half = memory.nor.slots() / 2;
-        if found.newest.is_none() && found.next == 0 {
-            memory.append()?;
-        } else if memory.next >= half {
+        if memory.next >= half {
             memory.move_to_other_page()?;
         } else {
             memory.append()?;
