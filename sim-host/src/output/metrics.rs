@@ -5,6 +5,7 @@
 use serde::Serialize;
 
 use crate::output::decimated::Decimated;
+use crate::output::torques::{TorqueFigures, TorqueTracker};
 use crate::session::simulator::Simulator;
 
 /// A joint counts as past its limit beyond this, rad (MuJoCo's limits are soft constraints:
@@ -94,6 +95,8 @@ pub struct SegmentSummary {
     pub torque_limit_violations: u64,
     /// Largest applied wheel torque, N·m.
     pub max_wheel_torque_nm: f64,
+    /// Peak and RMS torques of the joints and wheels, and the drives' saturation.
+    pub torques: TorqueFigures,
     /// Cycles in which a foot or a body part touched the ground.
     pub feet_or_body_on_ground_cycles: u64,
     /// Cycles in which a body part (torso, leg link) touched the ground.
@@ -126,6 +129,7 @@ pub struct SegmentTracker {
     start_bus: BusCounters,
     limits: [(f64, f64); 4],
     wheel_limit_nm: f64,
+    torques: TorqueTracker,
     /// (time s, x m, y m, unwrapped yaw deg) of every cycle (of fewer in a segment longer
     /// than 4.4 simulated minutes: bounded memory).
     track: Decimated<(f64, f64, f64, f64)>,
@@ -162,6 +166,7 @@ impl SegmentTracker {
                 max_joint_excess_deg: 0.0,
                 torque_limit_violations: 0,
                 max_wheel_torque_nm: 0.0,
+                torques: TorqueFigures::default(),
                 feet_or_body_on_ground_cycles: 0,
                 body_on_ground_cycles: 0,
                 torso_on_ground_cycles: 0,
@@ -177,6 +182,7 @@ impl SegmentTracker {
             start_bus: bus,
             limits,
             wheel_limit_nm: f64::from(config.wheel_torque_limit_nm),
+            torques: TorqueTracker::start(sim),
             track: Decimated::default(),
         }
     }
@@ -224,6 +230,7 @@ impl SegmentTracker {
         if largest > self.wheel_limit_nm + 1e-6 {
             s.torque_limit_violations += 1;
         }
+        self.torques.observe(sim);
         let loaded = physics.foot_forces_n().map(|f| f > FOOT_CONTACT_N);
         if loaded.iter().any(|l| *l) || contacts.other {
             s.feet_or_body_on_ground_cycles += 1;
@@ -247,6 +254,7 @@ impl SegmentTracker {
 
     /// The segment's figures.
     pub fn finish(mut self) -> SegmentSummary {
+        self.summary.torques = self.torques.figures();
         let start_s = self.summary.start_s;
         let track = std::mem::take(&mut self.track).into_vec();
         if let Some(&(_, x1, y1, _)) = track.iter().find(|(t, ..)| *t >= start_s + 1.0) {

@@ -13,5 +13,6 @@ pub mod render;
 pub mod summary;
 pub mod telemetry;
 pub mod telemetry_csv;
+pub mod torques;
 #[cfg(feature = "viewer")]
 pub mod viewer;
