@@ -9,6 +9,7 @@ use crate::legs::support::SupportGeometry;
 use crate::limits::JointLimits;
 use crate::time::TickRate;
 use crate::wheels::balance::{BalanceConfig, BalanceGains, BalanceModel};
+use crate::wheels::runaway::RunawayConfig;
 use crate::wheels::wheel::SpeedLoopGains;
 
 /// Controller configuration.
@@ -69,8 +70,11 @@ pub struct Config {
     pub link_recover_permille: u32,
     /// Pitch or roll beyond this is a fall: fault, rad.
     pub tilt_limit_rad: f32,
-    /// The E-stop's controlled stop (within [`crate::control::safety::SS1_DEADLINE_MS`]).
+    /// The E-stop's controlled stop (within [`crate::control::safety::SS1_DEADLINE_MS`]),
+    /// also run when the wheels stall or run away.
     pub stop: StopConfig,
+    /// When the wheels count as stalled or running away.
+    pub runaway: RunawayConfig,
 }
 
 /// Per-wheel torque limit of the robot, N·m.
@@ -110,6 +114,7 @@ impl Config {
         link_recover_permille: 30,
         tilt_limit_rad: crate::math::deg_to_rad(45.0),
         stop: StopConfig::ROBOT,
+        runaway: RunawayConfig::ROBOT,
     };
 
     /// This configuration at another control rate (gains are per second, so only the tick

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{command, imu, leg_feedback, wheels_at_rest, Ticks};
+use common::{command, imu, leg_feedback, Ticks};
 
 use firmware::control::controller::Output;
 use firmware::control::fsm::{LegMotion, State, WheelMotion};
@@ -72,7 +72,9 @@ impl Bench {
                 self.controller
                     .on_message(now, &AnyMessage::LegFeedback(leg, leg_feedback(angles_rad)));
             }
-            self.controller.on_message(now, &wheels_at_rest());
+            let wheels_rad_s = common::following_wheels_rad_s(&self.controller);
+            self.controller
+                .on_message(now, &common::wheels_at(wheels_rad_s));
         }
         if self.imu_alive {
             self.controller

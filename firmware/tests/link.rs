@@ -85,7 +85,8 @@ impl LossyBench {
     }
 
     fn tick(&mut self) -> Output {
-        for message in common::plant_feedback(&self.joints_rad) {
+        let wheels_rad_s = common::following_wheels_rad_s(self.node.controller());
+        for message in common::plant_feedback_rolling(&self.joints_rad, wheels_rad_s) {
             self.send(message);
         }
         if self.now % 5 == 0 {

@@ -237,6 +237,12 @@ wire_flags!(
         /// E-stop release, or a lost operator, nothing moves until the operator sends STOP
         /// (X) and then a motion.
         AWAITING_STOP = 9 => "awaiting_stop",
+        /// The wheels could not follow the speed reference (something blocks them: a step they
+        /// cannot climb): the robot was braked and set down.
+        WHEEL_STALL = 10 => "wheel_stall",
+        /// The robot moved away from the speed reference, or the balance law stayed saturated
+        /// (a centre of mass off its trim, a push it cannot take): braked and set down.
+        RUNAWAY = 11 => "runaway",
     }
 );
 

@@ -125,6 +125,8 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
                 "non_finite",
                 "link_degraded",
                 "awaiting_stop",
+                "wheel_stall",
+                "runaway",
             ];
             for (bit, flag) in flags.iter().enumerate() {
                 put(

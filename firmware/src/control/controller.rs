@@ -10,21 +10,23 @@
 //! 5. every output is clamped to the joint and torque limits and made finite.
 
 mod status;
+mod stopping;
 
-use protocol::{AnyMessage, DriveFlags, EStopAction, Joints, Leg, PerDrive};
+use protocol::{AnyMessage, DriveFlags, EStopAction, FaultFlags, Joints, Leg, PerDrive};
 
 use crate::config::Config;
 use crate::control::fsm::{Direction, Event, LegMotion, State, WheelMotion};
 pub use crate::control::output::{ConfigError, Output, Status};
 use crate::control::safety::{clamp_leg_targets, clamp_wheel_torques};
 use crate::control::sensors::Sensors;
-use crate::control::stop::{Carrier, Stop, StopCommand, StopInput};
+use crate::control::stop::Stop;
 use crate::control::teleop::Teleop;
 use crate::legs::gait::Trot;
 use crate::legs::kinematics::LegJoints;
 use crate::legs::smoothing::Smoother;
 use crate::time::Tick;
 use crate::wheels::balance::{Balance, BalanceInput};
+use crate::wheels::runaway::{Runaway, RunawayInput};
 use crate::wheels::wheel::{mix, SpeedLoop};
 
 /// The robot's controller.
@@ -56,8 +58,12 @@ pub struct Controller {
     /// [`Controller::set_clock_stalled`]).
     clock_stalled: bool,
     ik_failures: u32,
-    /// The controlled stop of the present E-stop (`None` outside `EStop`).
+    /// The controlled stop of the present E-stop, or of a stall or runaway in `Fault` (`None`
+    /// otherwise).
     stop: Option<Stop>,
+    runaway: Runaway,
+    /// What the runaway detector found, reported until the fault is reset.
+    wheel_fault: FaultFlags,
 }
 
 impl Controller {
@@ -87,6 +93,8 @@ impl Controller {
             clock_stalled: false,
             ik_failures: 0,
             stop: None,
+            runaway: Runaway::new(&config.runaway, rate),
+            wheel_fault: FaultFlags::EMPTY,
         })
     }
 
@@ -162,7 +170,8 @@ impl Controller {
             AnyMessage::TeleopCommand(command) => {
                 if let Some(mode) = self.teleop.command(now, command) {
                     if self.state == State::Fault && mode == protocol::TeleopMode::Stop {
-                        if self.fault_causes(now).is_empty() {
+                        let stopping = self.stop.is_some_and(|stop| !stop.off());
+                        if self.fault_causes(now).is_empty() && !stopping {
                             self.apply(Event::Reset);
                         }
                     } else if self.link_degraded && mode != protocol::TeleopMode::Stop {
@@ -200,13 +209,8 @@ impl Controller {
         let mut wheel_torque_nm = [0.0; 2];
         let mut legs_enabled = self.armed;
         match self.state {
-            State::EStop => match self.stop_command(now) {
-                StopCommand::Servo(targets) => self.legs_rad = targets,
-                StopCommand::Off => {
-                    legs_enabled = false;
-                    self.follow_measured();
-                }
-            },
+            State::EStop => legs_enabled &= self.run_stop(now),
+            State::Fault if self.stop.is_some() => legs_enabled &= self.run_stop(now),
             State::Hold | State::Fault => {}
             State::Standing(motion) if self.rolling() => {
                 // Stop on the wheels first: legs that unfold under a rolling robot lift it off
@@ -228,7 +232,11 @@ impl Controller {
                 self.smooth(self.config.fold_rate_per_s);
             }
         }
-        if self.balancing() && self.armed && self.wheels_may_drive() {
+        if self.stop.is_some_and(|stop| stop.holds_wheels()) {
+            let gain = self.config.stop.wheel_hold_nm_per_rad_s;
+            let [left, right] = self.sensors.wheel_rate_rad_s;
+            wheel_torque_nm = [-gain * left, -gain * right];
+        } else if self.balancing() && self.armed && self.wheels_may_drive() {
             wheel_torque_nm = self.wheel_law(now, dt_s);
         } else {
             self.balance.reset();
@@ -276,49 +284,11 @@ impl Controller {
         }
     }
 
-    /// An E-stop latch at `now`: `EStop` from this tick on, with a controlled stop if the robot
-    /// is under way, or every drive torque-free at once from `Hold`, `Fault` or unarmed (see
-    /// [`crate::control::stop`]). A latch while latched changes nothing.
-    fn latch(&mut self, now: Tick) {
-        if self.state == State::EStop {
-            return;
-        }
-        let carrier = if !self.armed || matches!(self.state, State::Hold | State::Fault) {
-            Carrier::Nothing
-        } else if self.wheels_may_drive() {
-            Carrier::Wheels
-        } else {
-            Carrier::Legs
-        };
-        let (config, rate) = (self.config.stop, self.config.rate);
-        let stop = Stop::new(config, rate, now, self.legs_rad, self.fold_rad, carrier);
-        self.stop = Some(stop);
-        self.apply(Event::EStopLatch);
-    }
-
-    /// This tick of the controlled stop (torque-free if none runs).
-    fn stop_command(&mut self, now: Tick) -> StopCommand {
-        let r = self.config.balance.wheel_radius_m;
-        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
-        let input = StopInput {
-            now,
-            speeds_m_s: [
-                r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s),
-                r * self.sensors.differential_wheel_rate_rad_s(),
-            ],
-            braked: self.balance.velocity_ref_m_s() == 0.0,
-            fault: self.non_finite || !self.fault_causes(now).is_empty(),
-        };
-        self.stop
-            .as_mut()
-            .map_or(StopCommand::Off, |stop| stop.step(&input))
-    }
-
     /// Whether the balance law runs (where the wheels are on the ground): in the states that
     /// carry the robot on its wheels, and in `EStop` until the controlled stop cuts the torque.
     fn balancing(&self) -> bool {
         match self.state {
-            State::EStop => self.stop.is_some_and(|stop| !stop.off()),
+            State::EStop | State::Fault => self.stop.is_some_and(|stop| !stop.off()),
             state => state.balancing(),
         }
     }
@@ -374,6 +344,12 @@ impl Controller {
         }
         if next != State::EStop {
             self.stop = None;
+        }
+        if self.state == State::Fault {
+            self.wheel_fault = FaultFlags::EMPTY;
+        }
+        if !matches!(next, State::Wheels(_)) {
+            self.runaway.reset();
         }
         self.state = next;
     }
@@ -443,6 +419,19 @@ impl Controller {
             },
             dt_s,
         );
+        if matches!(self.state, State::Wheels(_)) {
+            let r = config.balance.wheel_radius_m;
+            let input = RunawayInput {
+                ground_speed_m_s: r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s),
+                velocity_ref_m_s: self.balance.velocity_ref_m_s(),
+                torque_nm: common,
+                torque_limit_nm: config.balance.torque_limit_nm,
+            };
+            if let Some(cause) = self.runaway.update(&config.runaway, &input) {
+                self.wheel_fault_stop(now, cause, input.ground_speed_m_s);
+            }
+        }
+        let config = &self.config;
         let differential = self.turn.update(
             turn_ref_rad_s - self.sensors.differential_wheel_rate_rad_s(),
             dt_s,

@@ -164,6 +164,18 @@ impl Balance {
         self.anchored = true;
     }
 
+    /// Takes the robot's present ground speed as the speed reference and forgets the position
+    /// error: a stop that starts from a stall or a runaway brakes from where the robot is, not
+    /// from what it was asked for.
+    pub fn rebase(&mut self, ground_speed_m_s: f32) {
+        if ground_speed_m_s.is_finite() {
+            self.velocity_ref_m_s = ground_speed_m_s;
+            self.last_speed_m_s = ground_speed_m_s;
+        }
+        self.position_error_m = 0.0;
+        self.anchored = false;
+    }
+
     /// The speed reference after the acceleration limit, m/s.
     pub fn velocity_ref_m_s(&self) -> f32 {
         self.velocity_ref_m_s

@@ -71,10 +71,22 @@ pub fn leg_feedback(positions_rad: &[f32]) -> LegFeedback {
 
 /// The wheel drive's feedback with both wheels at rest.
 pub fn wheels_at_rest() -> AnyMessage {
+    wheels_at(0.0)
+}
+
+/// The wheel drive's feedback with both wheels turning at `rate_rad_s`.
+pub fn wheels_at(rate_rad_s: f32) -> AnyMessage {
     AnyMessage::WheelFeedback(WheelFeedback {
-        velocity: [WheelVelocity::saturating_from_si(0.0); 2],
+        velocity: [WheelVelocity::saturating_from_si(rate_rad_s); 2],
         effort: [Torque::saturating_from_si(0.0); 2],
     })
+}
+
+/// The wheel rate of an ideal plant that rolls at the balance law's speed reference, rad/s:
+/// its wheels do what the law asks, so the stall and runaway detector stays quiet.
+pub fn following_wheels_rad_s(controller: &firmware::Controller) -> f32 {
+    let r = controller.config().balance.wheel_radius_m;
+    controller.balance().velocity_ref_m_s() / r
 }
 
 /// An IMU sample of a torso pitched by `pitch_rad`, still, in 1 g.
@@ -90,11 +102,16 @@ pub fn imu(pitch_rad: f32) -> Imu {
 /// One tick of an ideal plant's feedback: the four legs at `joints_rad`, the wheels at rest,
 /// the torso level.
 pub fn plant_feedback(joints_rad: &Joints<f32>) -> Vec<AnyMessage> {
+    plant_feedback_rolling(joints_rad, 0.0)
+}
+
+/// [`plant_feedback`] with the wheels turning at `wheel_rate_rad_s`.
+pub fn plant_feedback_rolling(joints_rad: &Joints<f32>, wheel_rate_rad_s: f32) -> Vec<AnyMessage> {
     let mut messages: Vec<AnyMessage> = joints_rad
         .iter_legs()
         .map(|(leg, angles_rad)| AnyMessage::LegFeedback(leg, leg_feedback(angles_rad)))
         .collect();
-    messages.push(wheels_at_rest());
+    messages.push(wheels_at(wheel_rate_rad_s));
     messages.push(AnyMessage::Imu(imu(0.0)));
     messages
 }

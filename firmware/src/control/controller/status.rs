@@ -22,6 +22,7 @@ impl Controller {
         if self.link_degraded {
             faults = faults.with(FaultFlags::LINK_DEGRADED);
         }
+        faults = faults.with(self.wheel_fault);
         if self.teleop.interlocked() {
             faults = faults.with(FaultFlags::AWAITING_STOP);
         }

@@ -1,0 +1,88 @@
+//! The controlled stop: the E-stop's latch, and the stall or runaway that stops the robot
+//! into `Fault` the same way (see [`crate::control::stop`]).
+
+use protocol::FaultFlags;
+
+use super::Controller;
+use crate::control::fsm::{Event, State};
+use crate::control::stop::{Carrier, Stop, StopCommand, StopInput};
+use crate::time::Tick;
+
+impl Controller {
+    /// An E-stop latch at `now`: `EStop` from this tick on, with a controlled stop if the robot
+    /// is under way, or every drive torque-free at once from `Hold`, `Fault` or unarmed (see
+    /// [`crate::control::stop`]). A latch while latched changes nothing.
+    pub(super) fn latch(&mut self, now: Tick) {
+        if self.state == State::EStop {
+            return;
+        }
+        if self.state == State::Fault && self.stop.is_some_and(|stop| !stop.off()) {
+            // A stall or runaway is already being stopped under control: the latch keeps it.
+            self.apply(Event::EStopLatch);
+            return;
+        }
+        let carrier = if !self.armed || matches!(self.state, State::Hold | State::Fault) {
+            Carrier::Nothing
+        } else if self.wheels_may_drive() {
+            Carrier::Wheels
+        } else {
+            Carrier::Legs
+        };
+        let (config, rate) = (self.config.stop, self.config.rate);
+        let stop = Stop::new(config, rate, now, self.legs_rad, self.fold_rad, carrier);
+        self.stop = Some(stop);
+        self.apply(Event::EStopLatch);
+    }
+
+    /// Runs this tick of the controlled stop: whether the legs stay enabled.
+    pub(super) fn run_stop(&mut self, now: Tick) -> bool {
+        match self.stop_command(now) {
+            StopCommand::Servo(targets) => {
+                self.legs_rad = targets;
+                true
+            }
+            StopCommand::Off => {
+                self.follow_measured();
+                false
+            }
+        }
+    }
+
+    /// A stall or runaway (`cause`) found at `now` on the wheels: `Fault`, with the controlled
+    /// stop of an E-stop on the wheels (brake from the present speed, kickstand, torque off),
+    /// since the controller itself is sound and cutting the torque would drop the robot.
+    pub(super) fn wheel_fault_stop(&mut self, now: Tick, cause: FaultFlags, ground_speed_m_s: f32) {
+        self.apply(Event::Fault);
+        if self.state != State::Fault {
+            return;
+        }
+        self.wheel_fault = cause;
+        self.balance.rebase(ground_speed_m_s);
+        let (config, rate) = (self.config.stop, self.config.rate);
+        let carrier = if cause == FaultFlags::WHEEL_STALL {
+            Carrier::Blocked
+        } else {
+            Carrier::Wheels
+        };
+        let stop = Stop::new(config, rate, now, self.legs_rad, self.fold_rad, carrier);
+        self.stop = Some(stop);
+    }
+
+    /// This tick of the controlled stop (torque-free if none runs).
+    fn stop_command(&mut self, now: Tick) -> StopCommand {
+        let r = self.config.balance.wheel_radius_m;
+        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        let input = StopInput {
+            now,
+            speeds_m_s: [
+                r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s),
+                r * self.sensors.differential_wheel_rate_rad_s(),
+            ],
+            braked: self.balance.velocity_ref_m_s() == 0.0,
+            fault: self.non_finite || !self.fault_causes(now).is_empty(),
+        };
+        self.stop
+            .as_mut()
+            .map_or(StopCommand::Off, |stop| stop.step(&input))
+    }
+}

@@ -1,0 +1,116 @@
+//! The stall and runaway detector in the closed loop (`firmware::wheels::runaway`): driving W
+//! into a step the wheels cannot climb raises a stall fault and sets the robot down against
+//! the step, and nothing runs away.
+//!
+//! `cargo test -p sim-host --test stall -- --nocapture` prints the figures. Lockstep is
+//! deterministic, so they repeat exactly.
+
+use std::path::Path;
+
+use firmware::control::fsm::State;
+use host_can::fault_plan::Faults;
+use protocol::{FaultFlags, TeleopMode};
+use sim_host::faults::rig::{Rig, PERIOD_US};
+use teleop_core::scripted::PlanStep;
+
+/// The obstacle scene: a 6 cm step whose riser stands at x = 1.5 m.
+const OBSTACLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models/obstacles.xml");
+
+/// Whether any part of the robot touches the step.
+fn touches_step(rig: &Rig) -> bool {
+    let physics = rig.sim().physics();
+    let step = physics
+        .model()
+        .name_to_id(
+            mujoco_rs::wrappers::mj_model::MjtObjBase::mjOBJ_GEOM,
+            "step",
+        )
+        .and_then(|id| i32::try_from(id).ok());
+    physics
+        .data()
+        .contact()
+        .iter()
+        .any(|c| Some(c.geom1) == step || Some(c.geom2) == step)
+}
+
+/// What driving into the step did, from the first contact with it.
+#[derive(Debug, Default)]
+struct Figures {
+    /// First contact of any part of the robot with the step, s, and the torso's x then, m.
+    contact: Option<(f64, f64)>,
+    /// Ground speed at the contact, m/s.
+    speed_at_contact_m_s: f64,
+    /// From the contact to the first cycle reporting `Fault`, s, and the fault flags then.
+    fault_after_s: Option<(f64, FaultFlags)>,
+    /// From the contact to the last cycle the torso moved faster than 2 cm/s, s.
+    moving_until_s: f64,
+    /// Torso x range from the contact to the end, m.
+    x_range_m: [f64; 2],
+    /// Largest tilt from the contact on, degrees.
+    max_tilt_deg: f64,
+    /// Whether the robot fell (tilt past 45° or the torso on the ground).
+    fell: bool,
+    /// Whether the controller left `Fault` without the operator.
+    left_fault: bool,
+}
+
+fn drive_into_the_step(end_s: f64) -> Figures {
+    let plan = vec![
+        PlanStep::at(0.0, TeleopMode::Fold),
+        PlanStep::at(1.5, TeleopMode::WheelForward),
+    ];
+    let mut rig = Rig::new(
+        Path::new(OBSTACLES),
+        plan,
+        &Faults::default(),
+        &Faults::default(),
+    )
+    .unwrap();
+    let mut f = Figures::default();
+    let end_us = (end_s * 1e6).round() as u64;
+    while rig.stats().cycles * PERIOD_US < end_us {
+        rig.step().unwrap();
+        let t = (rig.stats().cycles * PERIOD_US) as f64 * 1e-6;
+        let record = rig.records().last().unwrap().clone();
+        let torso = rig.sim().physics().torso();
+        let x = torso.pos_m[0];
+        let speed = torso.vel_m_s[0].hypot(torso.vel_m_s[1]);
+        let Some((contact_s, _)) = f.contact else {
+            if touches_step(&rig) {
+                f.contact = Some((t, x));
+                f.speed_at_contact_m_s = speed;
+                f.x_range_m = [x, x];
+            }
+            continue;
+        };
+        f.x_range_m = [f.x_range_m[0].min(x), f.x_range_m[1].max(x)];
+        f.max_tilt_deg = f.max_tilt_deg.max(record.tilt_deg);
+        f.fell |= record.fallen();
+        if speed > 0.02 {
+            f.moving_until_s = t - contact_s;
+        }
+        let faulted = record.state == Some(State::Fault);
+        match f.fault_after_s {
+            None if faulted => f.fault_after_s = Some((t - contact_s, record.faults)),
+            Some(_) => f.left_fault |= !faulted,
+            None => {}
+        }
+    }
+    f
+}
+
+#[test]
+fn driving_into_a_step_the_wheels_cannot_climb_stops_with_a_stall_fault() {
+    let f = drive_into_the_step(12.0);
+    println!("MEASURED W into the 6 cm step: {f:#?}");
+    let (_, contact_x) = f.contact.expect("never reached the step");
+    assert!(f.speed_at_contact_m_s > 0.4, "not at speed: {f:#?}");
+    let (fault_s, flags) = f.fault_after_s.expect("no fault");
+    assert!(fault_s <= 0.5, "{f:#?}");
+    assert!(flags.contains(FaultFlags::WHEEL_STALL), "{f:#?}");
+    assert!(!f.left_fault, "{f:#?}");
+    // No runaway: the robot stays within 0.5 m of where it met the step.
+    let [low, high] = f.x_range_m;
+    assert!(contact_x - low <= 0.5 && high - contact_x <= 0.5, "{f:#?}");
+    assert!(!f.fell, "{f:#?}");
+}
