@@ -102,6 +102,8 @@ impl Config {
             torque_limit_nm: 2.0 * WHEEL_TORQUE_LIMIT_NM,
             position_error_limit_m: 0.3,
             pitch_trim_rad: crate::math::deg_to_rad(3.2),
+            trim_time_constant_s: 2.0,
+            trim_range_rad: crate::math::deg_to_rad(15.0),
             accel_limit_m_s2: 0.35,
             brake_limit_m_s2: 0.8,
             wheel_viscous_nm_per_rad_s: 2.0,

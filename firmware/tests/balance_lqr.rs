@@ -123,8 +123,21 @@ fn open_loop_is_unstable_and_closed_loop_is_stable() {
 }
 
 /// Runs the firmware's `Balance` (f32) on the discrete linear model; returns the state
-/// history `[p_true, θ, v, θ̇]` and the torques.
+/// history `[p_true, θ, v, θ̇]` and the torques. The model's θ is the lean from the balance
+/// point, which the IMU reads at the configured trim plus `trim_error_rad` (a robot whose
+/// centre of mass is not where the trim says).
 fn simulate(pitch0_rad: f64, velocity_ref_m_s: f32, seconds: f64) -> (Vec<[f64; 4]>, Vec<f32>) {
+    simulate_off_trim(pitch0_rad, velocity_ref_m_s, seconds, 0.0).0
+}
+
+/// [`simulate`] with a trim error; also returns the learned trim at the end, rad.
+#[allow(clippy::type_complexity)]
+fn simulate_off_trim(
+    pitch0_rad: f64,
+    velocity_ref_m_s: f32,
+    seconds: f64,
+    trim_error_rad: f32,
+) -> ((Vec<[f64; 4]>, Vec<f32>), f32) {
     let (a, b) = continuous(&BalanceModel::ROBOT);
     let (ad, bd) = discrete(&a, &b, DT_S);
     let config = Config::ROBOT.balance;
@@ -135,7 +148,7 @@ fn simulate(pitch0_rad: f64, velocity_ref_m_s: f32, seconds: f64) -> (Vec<[f64; 
     let mut torques = Vec::new();
     for _ in 0..(seconds / DT_S) as usize {
         let input = BalanceInput {
-            pitch_rad: x[1] as f32,
+            pitch_rad: x[1] as f32 + config.pitch_trim_rad + trim_error_rad,
             pitch_rate_rad_s: x[3] as f32,
             wheel_rate_rad_s: (x[2] / r - x[3]) as f32,
             velocity_ref_m_s,
@@ -145,7 +158,28 @@ fn simulate(pitch0_rad: f64, velocity_ref_m_s: f32, seconds: f64) -> (Vec<[f64; 
         x = ad * x + bd * torque as f64;
         states.push([x[0], x[1], x[2], x[3]]);
     }
-    (states, torques)
+    ((states, torques), balance.pitch_trim_rad())
+}
+
+#[test]
+fn learns_a_trim_error_at_rest_and_stops_drifting() {
+    // An IMU mounted 5° off in pitch (or a centre of mass ~1.3 cm off): the fixed trim would
+    // need a standing position error of 0.2 m; the learned one needs none.
+    for error_deg in [5.0_f32, -5.0] {
+        let error_rad = error_deg.to_radians();
+        let ((states, _), learned) = simulate_off_trim(0.0, 0.0, 40.0, error_rad);
+        let expected = Config::ROBOT.balance.pitch_trim_rad + error_rad;
+        assert!(
+            (learned - expected).abs() < 0.2_f32.to_radians(),
+            "{error_deg}°: learned {learned} rad, expected {expected}"
+        );
+        // Over the last 30 s the robot stays within 5 cm.
+        let tail = &states[(10.0 / DT_S) as usize..];
+        let (low, high) = tail.iter().fold((f64::MAX, f64::MIN), |(lo, hi), s| {
+            (lo.min(s[0]), hi.max(s[0]))
+        });
+        assert!(high - low < 0.05, "{error_deg}°: drifted {} m", high - low);
+    }
 }
 
 #[test]

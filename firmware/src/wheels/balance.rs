@@ -101,8 +101,13 @@ pub struct BalanceConfig {
     /// Bound on the position error the law remembers, m.
     pub position_error_limit_m: f32,
     /// Pitch at which the body's centre of mass is over the axle, rad (a fold pose that puts
-    /// mass behind the hips needs a forward lean).
+    /// mass behind the hips needs a forward lean): the starting value of the learned trim.
     pub pitch_trim_rad: f32,
+    /// Time constant of the trim learning, s: while the reference is steady and the body
+    /// still, the trim follows the measured pitch this slowly (see [`Balance::pitch_trim_rad`]).
+    pub trim_time_constant_s: f32,
+    /// The learned trim stays within this of `pitch_trim_rad`, rad.
+    pub trim_range_rad: f32,
     /// The speed reference speeds up at most this fast, m/s²: a step in speed would throw the
     /// pendulum over by the lean it needs to accelerate (about 0.2 rad per m/s² on this robot,
     /// plus the law's overshoot).
@@ -115,6 +120,24 @@ pub struct BalanceConfig {
     /// error (which the robot would make up by overshooting, and give back after a stop).
     pub wheel_viscous_nm_per_rad_s: f32,
 }
+
+/// Pitch rate below which the body counts as still for the trim learning, rad/s.
+const TRIM_STILL_RAD_S: f32 = 0.05;
+
+/// Ground acceleration below which the robot counts as quasi-static for the trim learning
+/// (rolling at rest or at a steady speed: its lean is then its balance point), m/s².
+const TRIM_STILL_M_S2: f32 = 0.05;
+
+/// Ground speed below which a robot asked to stand counts as at rest for the trim learning,
+/// m/s.
+const TRIM_REST_M_S: f32 = 0.05;
+
+/// Fraction of the position-error bound past which the law has run out of position authority
+/// (it cannot hold the robot against a trim error: it drifts).
+const TRIM_AUTHORITY: f32 = 0.95;
+
+/// Weight of one tick's acceleration in its filtered value (about 40 ms at 250 Hz).
+const TRIM_ACCEL_FILTER: f32 = 0.1;
 
 /// Ground speed below which a braking robot counts as stopped, m/s.
 const STOPPED_M_S: f32 = 0.02;
@@ -142,6 +165,10 @@ pub struct Balance {
     last_speed_m_s: f32,
     /// Whether the position is held where the robot came to rest (see [`Balance::update`]).
     anchored: bool,
+    /// The learned pitch trim, rad.
+    trim_rad: f32,
+    /// Ground acceleration, filtered, m/s²: the trim is learned only while it is near zero.
+    accel_m_s2: f32,
 }
 
 impl Balance {
@@ -153,7 +180,37 @@ impl Balance {
             velocity_ref_m_s: 0.0,
             last_speed_m_s: 0.0,
             anchored: true,
+            trim_rad: config.pitch_trim_rad,
+            accel_m_s2: 0.0,
         }
+    }
+
+    /// One step of the trim learning: while the robot is asked to stand and is `settled` (at
+    /// rest, or drifting because the law has used up its position authority), the body turns
+    /// slower than [`TRIM_STILL_RAD_S`] and the robot accelerates less than
+    /// [`TRIM_STILL_M_S2`], the trim moves by the trim error that the remembered
+    /// position error stands for (at equilibrium the law's position and pitch terms cancel:
+    /// `k_p p = −k_θ (θ − trim)`).
+    fn learn_trim(&mut self, input: &BalanceInput, settled: bool, dt_s: f32) {
+        let still = input.pitch_rate_rad_s.abs() < TRIM_STILL_RAD_S
+            && self.accel_m_s2.abs() < TRIM_STILL_M_S2;
+        let tau_s = self.config.trim_time_constant_s;
+        let k = self.config.gains;
+        let error_rad = -self.position_error_m * k.position_nm_per_m / k.pitch_nm_per_rad;
+        if !(settled && still && error_rad.is_finite() && tau_s > 0.0) {
+            return;
+        }
+        let gain = crate::math::clamp(dt_s / tau_s, 0.0, 1.0);
+        let nominal = self.config.pitch_trim_rad;
+        let range = self.config.trim_range_rad;
+        let learned = self.trim_rad + gain * error_rad;
+        let learned = crate::math::clamp(learned, nominal - range, nominal + range);
+        // What the trim takes over, the position error gives up: the law stays at the same
+        // equilibrium, so the robot stays where it is instead of rolling back to where its
+        // position error was counted from.
+        let taken_rad = learned - self.trim_rad;
+        self.trim_rad = learned;
+        self.position_error_m += taken_rad * k.pitch_nm_per_rad / k.position_nm_per_m;
     }
 
     /// Forgets the position error (when the wheels take over).
@@ -174,6 +231,20 @@ impl Balance {
         }
         self.position_error_m = 0.0;
         self.anchored = false;
+    }
+
+    /// The learned pitch trim, rad: where this robot's centre of mass is over the axle.
+    ///
+    /// A robot is not its drawing: with the torso's centre of mass 3 cm behind where the model
+    /// has it, the fixed trim left the law needing more standing position error than it may
+    /// remember, and the robot rolled away at 0.15 m/s, leaning 14°. While the speed
+    /// robot is asked to stand, quasi-static, and at rest or drifting, the trim integrates the
+    /// trim error that the position error the law holds stands for (time constant
+    /// [`BalanceConfig::trim_time_constant_s`]), and the position error gives up as much: the
+    /// robot stays where it is, and the law ends needing no standing position error.
+    /// [`Balance::reset`] keeps what was learned.
+    pub fn pitch_trim_rad(&self) -> f32 {
+        self.trim_rad
     }
 
     /// The speed reference after the acceleration limit, m/s.
@@ -206,7 +277,17 @@ impl Balance {
         let step = limit_m_s2 * dt_s;
         let velocity_ref = current + crate::math::clamp(change, -step, step);
         let speed_error = self.ground_speed_m_s(input) - velocity_ref;
-        let pitch = input.pitch_rad - self.config.pitch_trim_rad;
+        let accel = (self.ground_speed_m_s(input) - self.last_speed_m_s) / dt_s;
+        if accel.is_finite() {
+            self.accel_m_s2 += TRIM_ACCEL_FILTER * (accel - self.accel_m_s2);
+        }
+        let at_rest = input.velocity_ref_m_s == 0.0 && velocity_ref == 0.0;
+        let speed = self.ground_speed_m_s(input);
+        let bound = self.config.position_error_limit_m;
+        let out_of_authority = self.position_error_m.abs() >= TRIM_AUTHORITY * bound;
+        let settled = speed.abs() < TRIM_REST_M_S || out_of_authority;
+        self.learn_trim(input, at_rest && settled, dt_s);
+        let pitch = input.pitch_rad - self.trim_rad;
         if !(speed_error.is_finite()
             && velocity_ref.is_finite()
             && pitch.is_finite()

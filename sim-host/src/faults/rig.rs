@@ -107,7 +107,18 @@ impl Rig {
         faults: &Faults,
         teleop_faults: &Faults,
     ) -> Result<Self, SessionError> {
-        let sim = Simulator::new(model, RIG_HZ, StartPose::standing(), Plant::default())?;
+        Self::with_plant(model, plan, faults, teleop_faults, Plant::default())
+    }
+
+    /// As [`Rig::new`], on `plant` (drives, IMU, a varied body).
+    pub fn with_plant(
+        model: &Path,
+        plan: Vec<PlanStep>,
+        faults: &Faults,
+        teleop_faults: &Faults,
+        plant: Plant,
+    ) -> Result<Self, SessionError> {
+        let sim = Simulator::new(model, RIG_HZ, StartPose::standing(), plant)?;
         let bus = InprocBus::new();
         let sim_bus = FaultyBus::new(bus.endpoint(), faults);
         let firmware = firmware_config(RIG_HZ).ok_or(SessionError::ControlRate(RIG_HZ))?;

@@ -11,4 +11,5 @@ pub mod model;
 pub mod physics;
 pub mod plant;
 pub mod rating;
+pub mod variation;
 pub mod wheel_drive;

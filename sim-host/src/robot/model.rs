@@ -115,6 +115,8 @@ pub struct Layout {
     pub wheel_geoms: [usize; 2],
     /// The four foot geoms (FL, FR, BL, BR).
     pub foot_geoms: [usize; 4],
+    /// The body each leg hangs from (`leg_fl` …): the leg is its subtree.
+    pub leg_bodies: [usize; 4],
 }
 
 /// Loads `path` and finds the layout the hardware needs.
@@ -148,6 +150,7 @@ impl Layout {
             torso_body: find.id("body", MjtObj::mjOBJ_BODY, "torso")?,
             wheel_geoms: [find.geom("wheel_left")?, find.geom("wheel_right")?],
             foot_geoms: [0; 4],
+            leg_bodies: [0; 4],
         };
         for (leg, names) in Joints::new(JOINT_NAMES).iter_legs() {
             for (k, name) in names.iter().enumerate() {
@@ -164,6 +167,7 @@ impl Layout {
             layout.leg_group[i] = model.actuator_group()[layout.leg_actuator.leg(leg)[0]] as u32;
             layout.foot_touch[i] = find.sensor(&format!("touch_{suffix}"), 1)?;
             layout.foot_geoms[i] = find.geom(&format!("foot_{suffix}"))?;
+            layout.leg_bodies[i] = find.id("body", MjtObj::mjOBJ_BODY, &format!("leg_{suffix}"))?;
         }
         layout.check_leg_groups(model, path)?;
         layout.find_wheels(&find)?;

@@ -9,6 +9,7 @@ use mujoco_rs::wrappers::mj_model::MjtObjBase as MjtObj;
 use protocol::{Joints, Leg};
 
 use crate::robot::model::{load, Layout, ModelError};
+use crate::robot::variation::Variation;
 
 /// Torso state from the simulator (ground truth).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -72,11 +73,21 @@ impl std::fmt::Debug for Physics {
 impl Physics {
     /// Loads the MJCF at `path`.
     pub fn load(path: &Path) -> Result<Self, ModelError> {
-        let (model, layout) = load(path)?;
-        Ok(Self {
-            data: MjData::new(Box::new(model)),
-            layout,
-        })
+        Self::load_varied(path, &Variation::NOMINAL)
+    }
+
+    /// Loads the MJCF at `path` and makes it into the robot `variation` describes.
+    pub fn load_varied(path: &Path, variation: &Variation) -> Result<Self, ModelError> {
+        let (mut model, layout) = load(path)?;
+        let nominal = variation.is_nominal();
+        if !nominal {
+            variation.apply(&mut model, &layout);
+        }
+        let mut data = MjData::new(Box::new(model));
+        if !nominal {
+            data.set_const();
+        }
+        Ok(Self { data, layout })
     }
 
     /// The MuJoCo model.

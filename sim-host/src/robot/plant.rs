@@ -1,8 +1,10 @@
-//! What the emulated hardware is made of, for a run: the IMU's noise and the drives' ratings.
+//! What the emulated hardware is made of, for a run: the IMU's noise, the drives' ratings and
+//! how the body differs from the model.
 //! The tested default is [`Plant::default`]; the ideal parts stay for debugging a controller.
 
 use crate::robot::imu::ImuNoise;
 use crate::robot::rating::Rating;
+use crate::robot::variation::Variation;
 
 /// The ratings the drives enforce.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -35,6 +37,8 @@ pub struct Plant {
     pub imu_noise: ImuNoise,
     /// What the drives can deliver.
     pub drives: DriveRatings,
+    /// How this robot's body differs from the model's.
+    pub variation: Variation,
 }
 
 impl Default for Plant {
@@ -45,6 +49,7 @@ impl Default for Plant {
         Self {
             imu_noise: ImuNoise::default(),
             drives: DriveRatings::IDEAL,
+            variation: Variation::NOMINAL,
         }
     }
 }

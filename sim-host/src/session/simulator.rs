@@ -78,7 +78,7 @@ impl Simulator {
         plant: Plant,
         key: Key,
     ) -> Result<Self, ModelError> {
-        let mut physics = Physics::load(model)?;
+        let mut physics = Physics::load_varied(model, &plant.variation)?;
         let timestep_s = physics.timestep_s();
         let period_s = 1.0 / f64::from(control_hz.max(1));
         let ratio = period_s / timestep_s;

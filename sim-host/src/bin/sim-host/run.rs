@@ -11,6 +11,7 @@ use host_can::fault_plan::Faults;
 use sim_host::robot::imu::ImuNoise;
 use sim_host::robot::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
 use sim_host::robot::plant::{DriveRatings, Plant};
+use sim_host::robot::variation::Variation;
 use sim_host::session::{self, BusChoice, Clock, FrameSettings, SegmentSpec, SessionConfig};
 use teleop_core::scenario::{mode_name, Scenario};
 use teleop_core::scripted::PlanStep;
@@ -268,6 +269,7 @@ fn session_config(args: &RunArgs, scenario: Option<&Scenario>, duration_s: f64) 
                 DrivesArg::Rated => DriveRatings::RATED,
                 DrivesArg::Ideal => DriveRatings::IDEAL,
             },
+            variation: Variation::NOMINAL,
         },
         teleop_plan,
         attach: None,
