@@ -6,6 +6,7 @@ use crate::legs::kinematics::LegGeometry;
 use crate::legs::posture::Posture;
 use crate::legs::smoothing::Smoother;
 use crate::legs::support::SupportGeometry;
+use crate::legs::transfer::TransferConfig;
 use crate::limits::JointLimits;
 use crate::time::TickRate;
 use crate::wheels::balance::{BalanceConfig, BalanceGains, BalanceModel};
@@ -34,8 +35,10 @@ pub struct Config {
     /// lifted its feet at the wrong end of the stride and did not move (measured in the
     /// simulator). A fast rate keeps only the smoothing of the step into the gait.
     pub gait_rate_per_s: f32,
-    /// Fold smoothing rate, 1/s (the report's 6).
+    /// Smoothing rate that holds the fold on the wheels, 1/s (the report's 6).
     pub fold_rate_per_s: f32,
+    /// The fold from the legs onto the wheels.
+    pub transfer: TransferConfig,
     /// A transition ends when every smoothed target is this close to its pose, rad.
     pub pose_tolerance_rad: f32,
     /// Wheel speed of W/S and of each wheel in A (the report's 4 rad/s).
@@ -92,6 +95,7 @@ impl Config {
         leg_rate_per_s: Smoother::LEG_RATE_PER_S,
         gait_rate_per_s: 50.0,
         fold_rate_per_s: Smoother::FOLD_RATE_PER_S,
+        transfer: TransferConfig::ROBOT,
         pose_tolerance_rad: 0.01,
         wheel_speed_rad_s: 4.0,
         wheel_torque_limit_nm: WHEEL_TORQUE_LIMIT_NM,

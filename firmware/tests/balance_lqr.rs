@@ -142,6 +142,7 @@ fn simulate_off_trim(
     let (ad, bd) = discrete(&a, &b, DT_S);
     let config = Config::ROBOT.balance;
     let mut balance = Balance::new(config);
+    balance.set_trim_learning(true);
     let mut x = Matrix4x1::new(0.0, pitch0_rad, 0.0, 0.0);
     let r = BalanceModel::ROBOT.wheel_radius_m as f64;
     let mut states = Vec::new();

@@ -72,7 +72,10 @@ fn a_centre_of_mass_off_the_drawing_is_learned_and_the_robot_stays_put() {
         // The balance point moves against the centre of mass: behind, the body leans forward.
         let moved_deg = f64::from(f.trim_deg) - 3.2;
         if f.offset_m != 0.0 {
-            assert!(moved_deg * f.offset_m < 0.0 && moved_deg.abs() > 2.0, "{f:?}");
+            assert!(
+                moved_deg * f.offset_m < 0.0 && moved_deg.abs() > 2.0,
+                "{f:?}"
+            );
         }
     }
 }

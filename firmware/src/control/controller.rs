@@ -9,6 +9,7 @@
 //! 4. the legs' targets move toward the goal with the report's smoothing;
 //! 5. every output is clamped to the joint and torque limits and made finite.
 
+mod folding;
 mod status;
 mod stopping;
 
@@ -24,6 +25,7 @@ use crate::control::teleop::Teleop;
 use crate::legs::gait::Trot;
 use crate::legs::kinematics::LegJoints;
 use crate::legs::smoothing::Smoother;
+use crate::legs::transfer::Transfer;
 use crate::time::Tick;
 use crate::wheels::balance::{Balance, BalanceInput};
 use crate::wheels::runaway::{Runaway, RunawayInput};
@@ -64,6 +66,16 @@ pub struct Controller {
     runaway: Runaway,
     /// What the runaway detector found, reported until the fault is reset.
     wheel_fault: FaultFlags,
+    /// The fold under way (`Folding`; `None` otherwise).
+    transfer: Option<Transfer>,
+    /// Whether that fold has ended.
+    transfer_done: bool,
+    /// When the balance law took the wheels (`None` while it does not drive them).
+    wheels_since: Option<Tick>,
+    /// Whether the measured leg pose leaves the wheels on the ground, once computed this tick.
+    grounded: Option<bool>,
+    /// The measured legs when a fold from the legs began (`None` otherwise).
+    fold_origin: Option<Joints<f32>>,
 }
 
 impl Controller {
@@ -95,6 +107,11 @@ impl Controller {
             stop: None,
             runaway: Runaway::new(&config.runaway, rate),
             wheel_fault: FaultFlags::EMPTY,
+            transfer: None,
+            transfer_done: false,
+            wheels_since: None,
+            grounded: None,
+            fold_origin: None,
         })
     }
 
@@ -199,6 +216,7 @@ impl Controller {
 
     /// Runs one control tick at `now`.
     pub fn step(&mut self, now: Tick) -> Output {
+        self.grounded = None;
         self.supervise(now);
         if !self.armed {
             self.follow_measured();
@@ -208,7 +226,8 @@ impl Controller {
         let previous = self.legs_rad;
         let mut wheel_torque_nm = [0.0; 2];
         let mut legs_enabled = self.armed;
-        match self.state {
+        let state = self.state;
+        match state {
             State::EStop => legs_enabled &= self.run_stop(now),
             State::Fault if self.stop.is_some() => legs_enabled &= self.run_stop(now),
             State::Hold | State::Fault => {}
@@ -227,18 +246,30 @@ impl Controller {
                 };
                 self.smooth(rate);
             }
-            State::Folding(_) | State::Wheels(_) => {
+            State::Folding(_) => self.fold_step(now, depth_m),
+            State::Wheels(_) => {
                 self.goal_rad = self.fold_rad;
                 self.smooth(self.config.fold_rate_per_s);
             }
         }
-        if self.stop.is_some_and(|stop| stop.holds_wheels()) {
+        if self.stop.is_some_and(|stop| stop.holds_wheels()) || self.folding_on_feet() {
             let gain = self.config.stop.wheel_hold_nm_per_rad_s;
             let [left, right] = self.sensors.wheel_rate_rad_s;
             wheel_torque_nm = [-gain * left, -gain * right];
+            self.wheels_since = None;
+            self.balance.reset();
         } else if self.balancing() && self.armed && self.wheels_may_drive() {
+            let since = *self.wheels_since.get_or_insert(now);
+            if since == now && matches!(self.state, State::Folding(_)) {
+                // The wheels take the robot where the feet carried it: back to where it stood.
+                self.balance.hold_at(self.carried_forward_m());
+            }
             wheel_torque_nm = self.wheel_law(now, dt_s);
+            if matches!(self.state, State::Folding(_)) {
+                self.ramp_in(&mut wheel_torque_nm, now.since(since));
+            }
         } else {
+            self.wheels_since = None;
             self.balance.reset();
             self.turn.reset();
         }
@@ -295,33 +326,11 @@ impl Controller {
 
     /// Whether the robot still rolls on its wheels (ground speed above 5 cm/s, or turning) while
     /// they carry it.
-    fn rolling(&self) -> bool {
+    fn rolling(&mut self) -> bool {
         let r = self.config.balance.wheel_radius_m;
         let speed_m_s = r * self.sensors.mean_wheel_rate_rad_s();
         let turn_m_s = r * self.sensors.differential_wheel_rate_rad_s();
         self.wheels_may_drive() && (speed_m_s.abs() > 0.05 || turn_m_s.abs() > 0.05)
-    }
-
-    /// On the wheels the balance law always runs; while folding or standing up only once the
-    /// measured leg pose puts the wheels on the ground (see [`crate::legs::support`]).
-    fn wheels_may_drive(&self) -> bool {
-        matches!(self.state, State::Wheels(_))
-            || self
-                .config
-                .support
-                .wheels_grounded(&self.config.geometry, &self.sensors.joint_position_rad)
-    }
-
-    /// Whether a running transition has brought every target to its pose (checked after
-    /// this tick's goal and smoothing, so the next tick runs the new state).
-    fn transition_arrived(&self) -> bool {
-        matches!(self.state, State::Standing(_) | State::Folding(_))
-            && self.armed
-            && self
-                .legs_rad
-                .iter()
-                .zip(&self.goal_rad)
-                .all(|(now, goal)| (goal - now).abs() <= self.config.pose_tolerance_rad)
     }
 
     fn apply(&mut self, event: Event) {
@@ -351,6 +360,9 @@ impl Controller {
         if !matches!(next, State::Wheels(_)) {
             self.runaway.reset();
         }
+        self.transfer = None;
+        self.transfer_done = false;
+        self.fold_origin = None;
         self.state = next;
     }
 
@@ -410,6 +422,8 @@ impl Controller {
             _ => (0.0, 0.0),
         };
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        self.balance
+            .set_trim_learning(matches!(self.state, State::Wheels(_) | State::Folding(_)));
         let common = self.balance.update(
             &BalanceInput {
                 pitch_rad: self.sensors.attitude.pitch_rad,

@@ -1,12 +1,15 @@
 //! The legs: [`kinematics`] (IK/FK of one leg), the poses ([`posture`]: stance and fold), the
 //! trot ([`gait`] with its [`phase`] clock, [`foot_trajectory`] and the report's
-//! [`sine_gait`]), [`smoothing`] of targets and [`support`] (which feet carry the robot).
+//! [`sine_gait`]), [`smoothing`] of targets, joint-space [`ramp`]s, the [`transfer`] from the
+//! legs onto the wheels and [`support`] (which feet carry the robot).
 
 pub mod foot_trajectory;
 pub mod gait;
 pub mod kinematics;
 pub mod phase;
 pub mod posture;
+pub mod ramp;
 pub mod sine_gait;
 pub mod smoothing;
 pub mod support;
+pub mod transfer;

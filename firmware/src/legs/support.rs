@@ -43,6 +43,12 @@ impl SupportGeometry {
         deepest_m + self.foot_radius_m
     }
 
+    /// Whether the feet have left the ground for the wheels: the legs would hold the torso at
+    /// least `margin_m` lower than the wheels do.
+    pub fn feet_clear(&self, geometry: &LegGeometry, joints_rad: &Joints<f32>) -> bool {
+        self.leg_height_m(geometry, joints_rad) < self.wheel_contact_height_m - self.margin_m
+    }
+
     /// Whether the wheels are on the ground (the legs hold the torso no higher than the wheels'
     /// contact height + margin).
     pub fn wheels_grounded(&self, geometry: &LegGeometry, joints_rad: &Joints<f32>) -> bool {

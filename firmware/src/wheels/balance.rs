@@ -132,9 +132,14 @@ const TRIM_STILL_M_S2: f32 = 0.05;
 /// m/s.
 const TRIM_REST_M_S: f32 = 0.05;
 
+/// How long a robot must have been at rest before its position error counts as a trim error,
+/// s: right after a stop, or after a fold hands it to the wheels with a deliberate position
+/// error ([`Balance::hold_at`]), it is still on its way back.
+const TRIM_REST_S: f32 = 1.0;
+
 /// Fraction of the position-error bound past which the law has run out of position authority
 /// (it cannot hold the robot against a trim error: it drifts).
-const TRIM_AUTHORITY: f32 = 0.95;
+const TRIM_AUTHORITY: f32 = 0.5;
 
 /// Weight of one tick's acceleration in its filtered value (about 40 ms at 250 Hz).
 const TRIM_ACCEL_FILTER: f32 = 0.1;
@@ -169,6 +174,10 @@ pub struct Balance {
     trim_rad: f32,
     /// Ground acceleration, filtered, m/s²: the trim is learned only while it is near zero.
     accel_m_s2: f32,
+    /// Whether the trim may be learned now (see [`Balance::set_trim_learning`]).
+    learning: bool,
+    /// How long the robot has been at rest, s.
+    rest_s: f32,
 }
 
 impl Balance {
@@ -182,24 +191,35 @@ impl Balance {
             anchored: true,
             trim_rad: config.pitch_trim_rad,
             accel_m_s2: 0.0,
+            learning: false,
+            rest_s: 0.0,
         }
     }
 
-    /// One step of the trim learning: while the robot is asked to stand and is `settled` (at
-    /// rest, or drifting because the law has used up its position authority), the body turns
-    /// slower than [`TRIM_STILL_RAD_S`] and the robot accelerates less than
-    /// [`TRIM_STILL_M_S2`], the trim moves by the trim error that the remembered
-    /// position error stands for (at equilibrium the law's position and pitch terms cancel:
-    /// `k_p p = −k_θ (θ − trim)`).
-    fn learn_trim(&mut self, input: &BalanceInput, settled: bool, dt_s: f32) {
+    /// Lets the trim be learned, or not: only while the robot balances with its legs folded or
+    /// folding (the pose the trim belongs to), not while it stands up.
+    pub fn set_trim_learning(&mut self, learning: bool) {
+        self.learning = learning;
+    }
+
+    /// One step of the trim learning: while the robot is asked to stand, and either has been
+    /// at rest for [`TRIM_REST_S`] with its body turning slower than [`TRIM_STILL_RAD_S`] and
+    /// accelerating less than [`TRIM_STILL_M_S2`] (`at_rest`), or drifts away because the law
+    /// has used up its position authority (`drifting`), the trim moves by the trim error that
+    /// the remembered position error stands for (at equilibrium the law's position and pitch
+    /// terms cancel: `k_p p = −k_θ (θ − trim)`).
+    fn learn_trim(&mut self, input: &BalanceInput, at_rest: bool, drifting: bool, dt_s: f32) {
         let still = input.pitch_rate_rad_s.abs() < TRIM_STILL_RAD_S
             && self.accel_m_s2.abs() < TRIM_STILL_M_S2;
+        let settled = (at_rest && still) || drifting;
         let tau_s = self.config.trim_time_constant_s;
         let k = self.config.gains;
         let error_rad = -self.position_error_m * k.position_nm_per_m / k.pitch_nm_per_rad;
-        if !(settled && still && error_rad.is_finite() && tau_s > 0.0) {
+        if !(self.learning && settled && error_rad.is_finite() && tau_s > 0.0) {
             return;
         }
+        // A drift is corrected four times faster: the robot is rolling away meanwhile.
+        let tau_s = if drifting { 0.25 * tau_s } else { tau_s };
         let gain = crate::math::clamp(dt_s / tau_s, 0.0, 1.0);
         let nominal = self.config.pitch_trim_rad;
         let range = self.config.trim_range_rad;
@@ -219,6 +239,16 @@ impl Balance {
         self.velocity_ref_m_s = 0.0;
         self.last_speed_m_s = 0.0;
         self.anchored = true;
+    }
+
+    /// Counts the robot as `ahead_m` ahead of where it should be (bounded as any position
+    /// error): the law rolls it back, and holds it there.
+    pub fn hold_at(&mut self, ahead_m: f32) {
+        if ahead_m.is_finite() {
+            let bound = self.config.position_error_limit_m;
+            self.position_error_m = crate::math::clamp(ahead_m, -bound, bound);
+            self.anchored = true;
+        }
     }
 
     /// Takes the robot's present ground speed as the speed reference and forgets the position
@@ -285,8 +315,13 @@ impl Balance {
         let speed = self.ground_speed_m_s(input);
         let bound = self.config.position_error_limit_m;
         let out_of_authority = self.position_error_m.abs() >= TRIM_AUTHORITY * bound;
-        let settled = speed.abs() < TRIM_REST_M_S || out_of_authority;
-        self.learn_trim(input, at_rest && settled, dt_s);
+        self.rest_s = if speed.abs() < TRIM_REST_M_S {
+            self.rest_s + dt_s
+        } else {
+            0.0
+        };
+        let rested = self.rest_s >= TRIM_REST_S;
+        self.learn_trim(input, at_rest && rested, at_rest && out_of_authority, dt_s);
         let pitch = input.pitch_rad - self.trim_rad;
         if !(speed_error.is_finite()
             && velocity_ref.is_finite()

@@ -1,0 +1,128 @@
+//! The moves between legs and wheels in place, in the closed loop in lockstep: the fold from
+//! standing (alone, or as the start of W, S or A, or right after a trot) and standing up from
+//! the wheels. What a user checks: the robot ends where it started (within 5 cm), it did not
+//! lean past 8°, and it ends in the mode asked for.
+//!
+//! `cargo test -p sim-host --test transitions -- --nocapture` prints the figures.
+
+use std::path::Path;
+
+use firmware::control::fsm::State;
+use host_can::fault_plan::Faults;
+use protocol::TeleopMode;
+use sim_host::faults::rig::Rig;
+use sim_host::robot::model::DEFAULT_MODEL;
+use teleop_core::scripted::PlanStep;
+
+/// One transition, from the key press that starts it until the robot is at rest after it (or,
+/// when the mode drives on, until the transition ends).
+#[derive(Debug)]
+struct Figures {
+    what: &'static str,
+    /// Horizontal torso displacement from the key press, m.
+    moved_m: f64,
+    /// Largest tilt meanwhile, degrees.
+    max_tilt_deg: f64,
+    /// How long the transition took, s.
+    took_s: f64,
+    /// The state at the end.
+    state: Option<State>,
+}
+
+/// Runs `before` (modes from 0 s), then presses `key` at `at_s`; measures until the robot's
+/// transition (`Folding` or `Standing`) is over and, if `rest`, the torso has come to rest.
+fn transition(
+    what: &'static str,
+    before: &[(f64, TeleopMode)],
+    key: TeleopMode,
+    at_s: f64,
+) -> Figures {
+    let mut plan: Vec<PlanStep> = before.iter().map(|&(t, m)| PlanStep::at(t, m)).collect();
+    plan.push(PlanStep::at(at_s, key));
+    let clean = Faults::default();
+    let mut rig = Rig::new(Path::new(DEFAULT_MODEL), plan, &clean, &clean).unwrap();
+    rig.run_until(at_s).unwrap();
+    let start = rig.sim().physics().torso().pos_m;
+    let drives_on = matches!(
+        key,
+        TeleopMode::WheelForward | TeleopMode::WheelBackward | TeleopMode::WheelRotate
+    );
+    let (mut max_tilt_deg, mut began, mut ended_s) = (0.0_f64, false, None);
+    while rig.time_s() < at_s + 10.0 {
+        rig.step().unwrap();
+        let record = rig.records().last().unwrap();
+        max_tilt_deg = max_tilt_deg.max(record.tilt_deg);
+        let moving = matches!(record.state, Some(State::Folding(_) | State::Standing(_)));
+        began |= moving;
+        if began && !moving && ended_s.is_none() {
+            ended_s = Some(rig.time_s() - at_s);
+            if drives_on {
+                break;
+            }
+        }
+        let speed = rig.sim().physics().torso().vel_m_s;
+        if ended_s.is_some() && speed[0].hypot(speed[1]) < 0.01 {
+            break;
+        }
+    }
+    let end = rig.sim().physics().torso().pos_m;
+    Figures {
+        what,
+        moved_m: (end[0] - start[0]).hypot(end[1] - start[1]),
+        max_tilt_deg,
+        took_s: ended_s.unwrap_or(f64::NAN),
+        state: rig.records().last().unwrap().state,
+    }
+}
+
+fn assert_in_place(f: &Figures) {
+    println!("MEASURED {}: {f:?}", f.what);
+    assert!(f.took_s.is_finite(), "never ended: {f:?}");
+    assert!(f.moved_m <= 0.05, "moved: {f:?}");
+    assert!(f.max_tilt_deg <= 8.0, "tilted: {f:?}");
+}
+
+const STAND: [(f64, TeleopMode); 2] = [(0.0, TeleopMode::Stop), (0.1, TeleopMode::Stand)];
+
+#[test]
+fn the_fold_from_standing_happens_in_place() {
+    assert_in_place(&transition(
+        "fold from standing",
+        &STAND,
+        TeleopMode::Fold,
+        1.5,
+    ));
+}
+
+#[test]
+fn w_s_and_a_from_standing_fold_in_place() {
+    for (what, key) in [
+        ("W from standing", TeleopMode::WheelForward),
+        ("S from standing", TeleopMode::WheelBackward),
+        ("A from standing", TeleopMode::WheelRotate),
+    ] {
+        assert_in_place(&transition(what, &STAND, key, 1.5));
+    }
+}
+
+#[test]
+fn the_fold_right_after_a_trot_happens_in_place() {
+    for (what, trot) in [
+        ("fold right after L", TeleopMode::TrotForward),
+        ("fold right after K", TeleopMode::TrotBackward),
+    ] {
+        let before = [(0.0, TeleopMode::Stop), (0.1, trot)];
+        assert_in_place(&transition(what, &before, TeleopMode::Fold, 4.0));
+    }
+}
+
+#[test]
+fn standing_up_from_the_wheels_happens_in_place() {
+    let before = [(0.0, TeleopMode::Stop), (0.1, TeleopMode::Fold)];
+    assert_in_place(&transition(
+        "stand-up from the wheels",
+        &before,
+        TeleopMode::Stand,
+        6.0,
+    ));
+}
