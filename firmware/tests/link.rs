@@ -212,7 +212,8 @@ fn twenty_percent_loss_brakes_a_wheel_drive_to_a_balanced_standstill() {
     let mut bench = LossyBench::new();
     bench.run(5);
     bench.press(TeleopMode::WheelForward);
-    bench.run(ticks_from_s(2));
+    // The fold sets the robot down in place first (a few seconds).
+    bench.run(ticks_from_s(5));
     let drive = State::Wheels(WheelMotion::Drive(Direction::Forward));
     assert_eq!(bench.state(), drive);
     bench.drop_every = Some(5);

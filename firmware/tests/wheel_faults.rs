@@ -46,7 +46,7 @@ impl Bench {
         bench.run(5);
         bench.send(command(TeleopMode::Stop));
         bench.send(command(TeleopMode::Fold));
-        bench.run(ms(2_000));
+        bench.run(ms(6_000));
         assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
         bench
     }

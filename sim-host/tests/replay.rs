@@ -73,17 +73,19 @@ fn record() -> (Rig, Vec<LoggedFrame>) {
     let plan = vec![
         PlanStep::at(0.0, TeleopMode::Stop),
         PlanStep::at(0.2, TeleopMode::WheelForward),
-        PlanStep::at(4.2, TeleopMode::Stop),
-        PlanStep::at(4.5, TeleopMode::WheelForward),
-        PlanStep::at(6.6, TeleopMode::Stop),
+        PlanStep::at(7.7, TeleopMode::Stop),
+        PlanStep::at(8.0, TeleopMode::WheelForward),
+        PlanStep::at(15.7, TeleopMode::Stop),
     ];
     let clean = Faults::default();
     let mut rig = Rig::new(DEFAULT_MODEL.as_ref(), plan, &clean, &clean).unwrap();
     let mut tap = rig.tap();
     let mut log = CandumpWriter::new(Vec::new(), "vcan0").unwrap();
-    let mut events = [(3.0, true), (4.0, false), (5.5, true), (6.5, false)].into_iter();
+    // The fold from standing takes about 4 s: each latch comes while driving, each release
+    // after the stop has set the robot down.
+    let mut events = [(5.0, true), (7.5, false), (13.0, true), (15.5, false)].into_iter();
     let mut next = events.next();
-    while rig.time_s() < 8.0 {
+    while rig.time_s() < 16.5 {
         if let Some((_, latching)) = next.filter(|(at_s, _)| rig.time_s() >= *at_s) {
             let frame = if latching {
                 latch()
@@ -101,7 +103,7 @@ fn record() -> (Rig, Vec<LoggedFrame>) {
     let released = rig
         .records()
         .iter()
-        .filter(|r| r.time_us > 7_000_000)
+        .filter(|r| r.time_us > 15_600_000)
         .all(|r| r.state != Some(State::EStop));
     assert!(released, "the recorded session ends released");
     let latches = frames.iter().filter(|f| is_latch(&f.frame)).count();
@@ -242,11 +244,11 @@ fn a_recorded_session_replayed_any_way_releases_nothing_and_moves_nothing() {
     let (mut rig, frames) = record();
     let non_latch = frames.iter().filter(|f| !is_latch(&f.frame)).count();
     println!(
-        "recorded {} frames ({non_latch} not latches) over 8 s",
+        "recorded {} frames ({non_latch} not latches) over 16.5 s",
         frames.len()
     );
     // Held at STOP, released, in the same session as the recording.
-    rig.run_until(9.0).unwrap();
+    rig.run_until(17.5).unwrap();
     assert_eq!(rig.records().last().unwrap().state, Some(State::Hold));
     replay_every_way(&mut rig, &frames, "the robot held at STOP", 1);
     // Latched, same session: the log's releases are refused as stale.

@@ -101,7 +101,7 @@ fn lockstep_latency(
 }
 
 #[test]
-fn in_lockstep_the_key_reaches_the_actuators_in_the_same_control_tick() {
+fn in_lockstep_the_estop_key_acts_in_the_same_control_tick_and_the_fold_within_eight() {
     let estop = lockstep_latency(Key::Char(' '), |(enable, _), _| {
         *enable == DriveEnable::Disabled
     });
@@ -110,9 +110,11 @@ fn in_lockstep_the_key_reaches_the_actuators_in_the_same_control_tick() {
     });
     println!("MEASURED lockstep key-to-actuator: E-stop {estop} cycles, F (fold) {fold} cycles (period 4 ms)");
     assert_eq!(estop, 0, "E-stop: the tick after the key disables the legs");
-    assert_eq!(
-        fold, 0,
-        "fold: the tick after the key moves the leg targets"
+    // The fold starts in the tick of the key, from rest: its joint-space ramps begin with zero
+    // rate (a smoothstep), so the targets first move by a wire count (1e-4 rad) a few ticks in.
+    assert!(
+        fold <= 8,
+        "fold: the leg targets move within 8 ticks of the key ({fold})"
     );
 }
 

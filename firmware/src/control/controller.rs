@@ -25,6 +25,7 @@ use crate::control::teleop::Teleop;
 use crate::legs::gait::Trot;
 use crate::legs::kinematics::LegJoints;
 use crate::legs::smoothing::Smoother;
+use crate::legs::support::LegStance;
 use crate::legs::transfer::Transfer;
 use crate::time::Tick;
 use crate::wheels::balance::{Balance, BalanceInput};
@@ -72,10 +73,14 @@ pub struct Controller {
     transfer_done: bool,
     /// When the balance law took the wheels (`None` while it does not drive them).
     wheels_since: Option<Tick>,
-    /// Whether the measured leg pose leaves the wheels on the ground, once computed this tick.
-    grounded: Option<bool>,
-    /// The measured legs when a fold from the legs began (`None` otherwise).
-    fold_origin: Option<Joints<f32>>,
+    /// Where the measured legs put the feet, once computed this tick (see
+    /// [`crate::legs::support`]).
+    leg_stance: Option<LegStance>,
+    /// The feet's mean position forward of the hips when a fold from the legs began, m
+    /// (`None` otherwise).
+    fold_origin_x_m: Option<f32>,
+    /// When the running fold's legs were tucked (`None` before, or with no fold).
+    fold_done_at: Option<Tick>,
 }
 
 impl Controller {
@@ -110,8 +115,9 @@ impl Controller {
             transfer: None,
             transfer_done: false,
             wheels_since: None,
-            grounded: None,
-            fold_origin: None,
+            leg_stance: None,
+            fold_origin_x_m: None,
+            fold_done_at: None,
         })
     }
 
@@ -216,7 +222,7 @@ impl Controller {
 
     /// Runs one control tick at `now`.
     pub fn step(&mut self, now: Tick) -> Output {
-        self.grounded = None;
+        self.leg_stance = None;
         self.supervise(now);
         if !self.armed {
             self.follow_measured();
@@ -262,7 +268,8 @@ impl Controller {
             let since = *self.wheels_since.get_or_insert(now);
             if since == now && matches!(self.state, State::Folding(_)) {
                 // The wheels take the robot where the feet carried it: back to where it stood.
-                self.balance.hold_at(self.carried_forward_m());
+                let carried_m = self.carried_forward_m();
+                self.balance.hold_at(carried_m);
             }
             wheel_torque_nm = self.wheel_law(now, dt_s);
             if matches!(self.state, State::Folding(_)) {
@@ -362,7 +369,8 @@ impl Controller {
         }
         self.transfer = None;
         self.transfer_done = false;
-        self.fold_origin = None;
+        self.fold_origin_x_m = None;
+        self.fold_done_at = None;
         self.state = next;
     }
 
@@ -423,7 +431,7 @@ impl Controller {
         };
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
         self.balance
-            .set_trim_learning(matches!(self.state, State::Wheels(_) | State::Folding(_)));
+            .set_trim_learning(matches!(self.state, State::Wheels(_)));
         let common = self.balance.update(
             &BalanceInput {
                 pitch_rad: self.sensors.attitude.pitch_rad,

@@ -10,6 +10,15 @@ use protocol::Joints;
 
 use crate::legs::kinematics::{leg_fk, LegGeometry, LegJoints};
 
+/// Where the legs put the feet, relative to the hips.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegStance {
+    /// The torso-centre height the legs give on flat ground, m.
+    pub height_m: f32,
+    /// The feet's mean position forward of their hips, m (a non-finite foot counts as 0).
+    pub mean_foot_x_m: f32,
+}
+
 /// Dimensions that decide which part touches the ground.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SupportGeometry {
@@ -33,20 +42,25 @@ impl SupportGeometry {
     /// The torso-centre height the legs give on flat ground, m: the deepest foot + its radius.
     /// Non-finite joint angles give 0 (the wheels are assumed to carry the robot).
     pub fn leg_height_m(&self, geometry: &LegGeometry, joints_rad: &Joints<f32>) -> f32 {
-        let mut deepest_m: f32 = 0.0;
+        self.stance_of(geometry, joints_rad).height_m
+    }
+
+    /// Where the measured legs put the feet, in one pass of the legs' kinematics.
+    pub fn stance_of(&self, geometry: &LegGeometry, joints_rad: &Joints<f32>) -> LegStance {
+        let (mut deepest_m, mut sum_x_m): (f32, f32) = (0.0, 0.0);
         for (_, &angles_rad) in joints_rad.iter_legs() {
             let foot = leg_fk(geometry, &LegJoints::from_array(angles_rad));
             if foot.z_m.is_finite() {
                 deepest_m = deepest_m.max(-foot.z_m);
             }
+            if foot.x_m.is_finite() {
+                sum_x_m += foot.x_m;
+            }
         }
-        deepest_m + self.foot_radius_m
-    }
-
-    /// Whether the feet have left the ground for the wheels: the legs would hold the torso at
-    /// least `margin_m` lower than the wheels do.
-    pub fn feet_clear(&self, geometry: &LegGeometry, joints_rad: &Joints<f32>) -> bool {
-        self.leg_height_m(geometry, joints_rad) < self.wheel_contact_height_m - self.margin_m
+        LegStance {
+            height_m: deepest_m + self.foot_radius_m,
+            mean_foot_x_m: 0.25 * sum_x_m,
+        }
     }
 
     /// Whether the wheels are on the ground (the legs hold the torso no higher than the wheels'

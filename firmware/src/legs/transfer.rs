@@ -61,7 +61,7 @@ impl TransferConfig {
         },
         settle_rate_rad_s: 2.0,
         carry_rate_rad_s: 0.6,
-        tuck_rate_rad_s: 1.5,
+        tuck_rate_rad_s: 2.5,
     };
 
     fn touchdown_pose(&self) -> Joints<f32> {

@@ -139,7 +139,7 @@ const TRIM_REST_S: f32 = 1.0;
 
 /// Fraction of the position-error bound past which the law has run out of position authority
 /// (it cannot hold the robot against a trim error: it drifts).
-const TRIM_AUTHORITY: f32 = 0.5;
+const TRIM_AUTHORITY: f32 = 0.95;
 
 /// Weight of one tick's acceleration in its filtered value (about 40 ms at 250 Hz).
 const TRIM_ACCEL_FILTER: f32 = 0.1;
@@ -196,8 +196,9 @@ impl Balance {
         }
     }
 
-    /// Lets the trim be learned, or not: only while the robot balances with its legs folded or
-    /// folding (the pose the trim belongs to), not while it stands up.
+    /// Lets the trim be learned, or not: only while the robot balances with its legs folded
+    /// (the pose the trim belongs to), not while a fold hands it to the wheels with a
+    /// deliberate position error ([`Balance::hold_at`]) or it stands up.
     pub fn set_trim_learning(&mut self, learning: bool) {
         self.learning = learning;
     }

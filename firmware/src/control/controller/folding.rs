@@ -5,13 +5,22 @@ use protocol::Joints;
 
 use super::Controller;
 use crate::control::fsm::State;
-use crate::legs::kinematics::{leg_fk, LegJoints};
+use crate::legs::support::LegStance;
 use crate::legs::transfer::Transfer;
 use crate::time::Tick;
 
 /// How long the balance law's torque takes to come in fully once the wheels take the robot in
 /// a fold, ms: a full torque on the first tick of contact jolts it.
 const WHEEL_RAMP_IN_MS: u32 = 300;
+
+/// A fold is back in place when the balance law's position error is below this, m, …
+const FOLD_RETURNED_M: f32 = 0.03;
+
+/// … and the robot rolls slower than this, m/s, …
+const FOLD_REST_M_S: f32 = 0.05;
+
+/// … or at the latest this long after the legs are tucked, ms.
+const FOLD_SETTLE_MS: u32 = 1_500;
 
 impl Controller {
     /// This tick of the fold: started on the first tick of the transition from where the legs
@@ -22,6 +31,8 @@ impl Controller {
             Some(running) => running,
             None => {
                 let on_wheels = self.wheels_may_drive();
+                let origin_x_m = self.stance().mean_foot_x_m;
+                self.fold_origin_x_m = (!on_wheels).then_some(origin_x_m);
                 let config = &self.config;
                 let stance = match config
                     .posture
@@ -34,7 +45,6 @@ impl Controller {
                     Err(_) => self.legs_rad,
                 };
                 let (from, goal) = (self.legs_rad, self.fold_rad);
-                self.fold_origin = (!on_wheels).then_some(self.sensors.joint_position_rad);
                 Transfer::new(
                     config.transfer,
                     config.rate,
@@ -49,30 +59,37 @@ impl Controller {
         let (pose, done) = transfer.step(now);
         self.legs_rad = pose;
         self.transfer = Some(transfer);
-        self.transfer_done = done;
+        if done && self.fold_done_at.is_none() {
+            self.fold_done_at = Some(now);
+        }
+        self.transfer_done = done && self.back_in_place(now);
+    }
+
+    /// Whether a fold whose legs are tucked has also brought the robot back to where it stood
+    /// and to rest (or has tried for [`FOLD_SETTLE_MS`]): a drive that starts before would
+    /// start from wherever the fold's return left it.
+    fn back_in_place(&self, now: Tick) -> bool {
+        let Some(done_at) = self.fold_done_at else {
+            return false;
+        };
+        let r = self.config.balance.wheel_radius_m;
+        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        let speed_m_s = r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s);
+        let returned = self.balance.position_error_m().abs() < FOLD_RETURNED_M;
+        let timed_out = now.since(done_at) >= self.config.rate.ticks_from_ms(FOLD_SETTLE_MS);
+        (returned && speed_m_s.abs() < FOLD_REST_M_S) || timed_out
     }
 
     /// How far the torso has moved forward over its planted feet since the fold began, m: the
     /// mean over the legs of how far each foot went back relative to its hip. The wheels were
     /// in the air, so the balance law's own odometry did not see it.
-    pub(super) fn carried_forward_m(&self) -> f32 {
-        let Some(origin) = self.fold_origin else {
+    pub(super) fn carried_forward_m(&mut self) -> f32 {
+        let Some(origin_x_m) = self.fold_origin_x_m else {
             return 0.0;
         };
-        let geometry = &self.config.geometry;
-        let now = &self.sensors.joint_position_rad;
-        let moved: f32 = origin
-            .iter_legs()
-            .zip(now.iter_legs())
-            .map(|((_, before), (_, after))| {
-                let before = leg_fk(geometry, &LegJoints::from_array(*before)).x_m;
-                let after = leg_fk(geometry, &LegJoints::from_array(*after)).x_m;
-                before - after
-            })
-            .sum();
-        let mean = 0.25 * moved;
-        if mean.is_finite() {
-            mean
+        let moved_m = origin_x_m - self.stance().mean_foot_x_m;
+        if moved_m.is_finite() {
+            moved_m
         } else {
             0.0
         }
@@ -93,23 +110,35 @@ impl Controller {
         if matches!(self.state, State::Wheels(_)) {
             return true;
         }
-        // The legs' kinematics cost ~700 instructions a leg on the MCU: once a tick.
-        let (config, joints) = (&self.config, &self.sensors.joint_position_rad);
-        *self
-            .grounded
-            .get_or_insert_with(|| config.support.wheels_grounded(&config.geometry, joints))
+        let support = self.config.support;
+        self.leg_height() <= support.wheel_contact_height_m + support.margin_m
     }
 
-    /// Whether a fold has set the robot on its wheels while its feet still carry part of it:
-    /// the wheels then hold still (a stool on wheels and feet), and the balance law takes over
-    /// once the tuck lifts the feet clear. Balancing on wheels and feet, the law read the lean
+    /// The torso height the measured legs give, m.
+    fn leg_height(&mut self) -> f32 {
+        self.stance().height_m
+    }
+
+    /// Where the measured legs put the feet: the legs' kinematics cost ~700 instructions a
+    /// leg on the MCU, so once a tick.
+    fn stance(&mut self) -> LegStance {
+        let (config, joints) = (&self.config, &self.sensors.joint_position_rad);
+        *self
+            .leg_stance
+            .get_or_insert_with(|| config.support.stance_of(&config.geometry, joints))
+    }
+
+    /// Whether a fold or a stand-up has the robot on its wheels while its feet carry part of
+    /// it: the wheels then hold still (a stool on wheels and feet); the balance law takes over
+    /// once a fold's tuck lifts the feet clear, and a stand-up's legs lift the wheels off. Balancing on wheels and feet, the law read the lean
     /// the feet gave the torso as a fall and drove the robot off its feet into a runaway.
     pub(super) fn folding_on_feet(&mut self) -> bool {
-        if !matches!(self.state, State::Folding(_)) || !self.wheels_may_drive() {
+        if !matches!(self.state, State::Folding(_) | State::Standing(_)) || !self.wheels_may_drive()
+        {
             return false;
         }
-        let (config, joints) = (&self.config, &self.sensors.joint_position_rad);
-        !config.support.feet_clear(&config.geometry, joints)
+        let support = self.config.support;
+        self.leg_height() >= support.wheel_contact_height_m - support.margin_m
     }
 
     /// Whether a running transition is over (checked after this tick's goal and move, so the
