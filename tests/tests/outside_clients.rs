@@ -311,7 +311,7 @@ fn teleop_send_from_a_script_folds_the_robot_and_the_controller_stops_when_it_qu
 #[test]
 fn teleop_script_drives_the_robot_and_a_bus_without_controller_exits_3() {
     let _alone = one_at_a_time();
-    let robot = PacedRobot::start("teleop-script", "14");
+    let robot = PacedRobot::start("teleop-script", "20");
     let script = workspace().join("scenarios/teleop_drive.toml");
     let teleop = Process::start(
         "teleop",

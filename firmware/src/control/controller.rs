@@ -367,10 +367,14 @@ impl Controller {
         if !matches!(next, State::Wheels(_)) {
             self.runaway.reset();
         }
-        self.transfer = None;
-        self.transfer_done = false;
-        self.fold_origin_x_m = None;
-        self.fold_done_at = None;
+        // A new request while folding (W after F) changes what follows the fold, not the fold.
+        let still_folding = matches!((self.state, next), (State::Folding(_), State::Folding(_)));
+        if !still_folding {
+            self.transfer = None;
+            self.transfer_done = false;
+            self.fold_origin_x_m = None;
+            self.fold_done_at = None;
+        }
         self.state = next;
     }
 
