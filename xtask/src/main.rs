@@ -34,8 +34,8 @@ Tasks:
   test               everything CI checks: fmt, clippy -D warnings (all features), DBC
                      freshness, no f64 in the no_std crates, all tests (the headless renderer's
                      too), a thumbv7em-none-eabihf build of the no_std crates, the MCU
-                     images (`firmware`, `pil`), a minute of fuzzing per target (`fuzz`), and
-                     the vcan suite (`hil`)
+                     images (`firmware`, `pil`), fuzzing (`fuzz`: a minute per frame target,
+                     20 s per other), and the vcan suite (`hil`)
   dbc [--check]      regenerate protocol/hybrid_robot.dbc (--check: fail if the committed file is stale)
   busload            print the per-cycle frame schedule and the bus load at 250 Hz and 1 kHz
   frame KIND [opts]  a valid frame as a `cansend` line: `latch` (the constant E-stop latch),
@@ -57,8 +57,10 @@ Tasks:
                      build's; prints instructions per control step and peak stack
                      (--record: rerun the closed loop and rewrite firmware/pil/recording.pil)
   fuzz [--seconds N] libFuzzer (cargo fuzz, nightly; installed if missing) on the frame decoders,
-                     the receive path and the firmware's frame handler, N s each (default 60)
-                     from the committed seeds; fails on a crash (--seeds: rewrite the seeds)
+                     the receive path, the firmware's frame handler, its E-stop contract and
+                     the host tools' text parsers (candump logs, fault plans, scenarios), N s
+                     each (default 60) from the committed seeds; fails on a crash (--seeds:
+                     rewrite the seeds)
   faults [--check]   the fault matrix (lost, late, corrupted, replayed frames, a teleop flood,
                      silent feedback, a killed firmware, a restarted simulator, E-stops) on the
                      closed loop in-process; writes its table into docs/faults.md (--check: fail
