@@ -331,6 +331,14 @@ impl Controller {
         }
     }
 
+    /// Ground speed of the axle, m/s: the wheels' joint rate is relative to the body, so the
+    /// body's pitch rate is added back.
+    fn ground_speed_m_s(&self) -> f32 {
+        let r = self.config.balance.wheel_radius_m;
+        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s)
+    }
+
     /// Whether the robot still rolls on its wheels (ground speed above 5 cm/s, or turning) while
     /// they carry it.
     fn rolling(&mut self) -> bool {
@@ -446,9 +454,8 @@ impl Controller {
             dt_s,
         );
         if matches!(self.state, State::Wheels(_)) {
-            let r = config.balance.wheel_radius_m;
             let input = RunawayInput {
-                ground_speed_m_s: r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s),
+                ground_speed_m_s: self.ground_speed_m_s(),
                 velocity_ref_m_s: self.balance.velocity_ref_m_s(),
                 torque_nm: common,
                 torque_limit_nm: config.balance.torque_limit_nm,

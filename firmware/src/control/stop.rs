@@ -73,6 +73,7 @@ use protocol::{Joints, Leg};
 
 use crate::control::safety::SS1_DEADLINE_MS;
 use crate::legs::kinematics::LegJoints;
+use crate::legs::ramp::ramp_ticks;
 use crate::math::deg_to_rad;
 use crate::time::{Tick, TickRate};
 
@@ -192,29 +193,6 @@ impl Ramp {
             *fr -= spread;
         }
         (pose, false)
-    }
-}
-
-/// Ticks for a smoothstep ramp from `from` to `to` whose fastest joint peaks at
-/// `peak_rate_rad_s` (a non-finite or non-positive rate, or a non-finite pose, gives 0: jump).
-fn ramp_ticks(from: &Joints<f32>, to: &Joints<f32>, peak_rate_rad_s: f32, rate: TickRate) -> u32 {
-    let largest = from
-        .iter()
-        .zip(to.iter())
-        .map(|(a, b)| (b - a).abs())
-        .fold(0.0_f32, f32::max);
-    // Smoothstep peaks at 1.5 × the mean rate.
-    let seconds = 1.5 * largest / peak_rate_rad_s;
-    let ticks = seconds * rate.hz() as f32;
-    if !(ticks.is_finite() && ticks > 0.0) {
-        return 0;
-    }
-    // Rounded up (the cast truncates, and saturates past u32::MAX).
-    let whole = ticks as u32;
-    if (whole as f32) < ticks {
-        whole.saturating_add(1)
-    } else {
-        whole
     }
 }
 

@@ -42,11 +42,6 @@ impl Ramp {
         }
     }
 
-    /// The pose it ends in.
-    pub fn goal(&self) -> &Joints<f32> {
-        &self.to
-    }
-
     /// How far along it is at `now`, 0…1 (in time, before the smoothstep).
     pub fn progress(&self, now: Tick) -> f32 {
         let elapsed = now.since(self.start);

@@ -72,9 +72,7 @@ impl Controller {
         let Some(done_at) = self.fold_done_at else {
             return false;
         };
-        let r = self.config.balance.wheel_radius_m;
-        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
-        let speed_m_s = r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s);
+        let speed_m_s = self.ground_speed_m_s();
         let returned = self.balance.position_error_m().abs() < FOLD_RETURNED_M;
         let timed_out = now.since(done_at) >= self.config.rate.ticks_from_ms(FOLD_SETTLE_MS);
         (returned && speed_m_s.abs() < FOLD_REST_M_S) || timed_out

@@ -71,11 +71,10 @@ impl Controller {
     /// This tick of the controlled stop (torque-free if none runs).
     fn stop_command(&mut self, now: Tick) -> StopCommand {
         let r = self.config.balance.wheel_radius_m;
-        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
         let input = StopInput {
             now,
             speeds_m_s: [
-                r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s),
+                self.ground_speed_m_s(),
                 r * self.sensors.differential_wheel_rate_rad_s(),
             ],
             braked: self.balance.velocity_ref_m_s() == 0.0,
