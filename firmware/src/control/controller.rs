@@ -184,7 +184,10 @@ impl Controller {
         match message {
             AnyMessage::EStop(estop) => match estop.action {
                 EStopAction::Latch => self.latch(now),
-                EStopAction::Clear => self.apply(Event::EStopClear),
+                EStopAction::Clear => {
+                    self.apply(Event::EStopClear);
+                    self.fault_on_held_cause();
+                }
             },
             AnyMessage::LegFeedback(leg, feedback) => self.sensors.record_leg(now, *leg, feedback),
             AnyMessage::WheelFeedback(feedback) => self.sensors.record_wheels(now, feedback),
@@ -310,6 +313,7 @@ impl Controller {
         if self.teleop.just_lost(now) {
             self.apply(Event::TeleopLost);
         }
+        self.fault_on_held_cause();
         if !self.armed || matches!(self.state, State::EStop | State::Fault) {
             return;
         }

@@ -3,6 +3,8 @@
 //! part of it.
 #![allow(dead_code)]
 
+pub mod bench;
+
 use firmware::config::Config;
 use firmware::Node;
 use protocol::{

@@ -43,11 +43,11 @@ use protocol::{
     FaultFlags, Frame, Joints, MessageId, TeleopMode,
 };
 
-/// Whether to check that a release leaves no fault behind. Off: the firmware fails it today
-/// (`EStopClear` takes `EStop` to `Hold` whatever fault causes remain, so latching and
-/// releasing the E-stop resets a fault without the check a STOP makes; the seeds
-/// `fault_after_release_*` show it). Turn on once that is fixed: those seeds then guard it.
-const CHECK_FAULT_AFTER_RELEASE: bool = false;
+/// Whether to check that a release leaves no fault behind (the seeds `fault_after_release_*`
+/// latch and release while a drive's fault or a frozen SYNC remains). A switch so that the
+/// oracle's own break check can show the check fails on a firmware that resets a fault on
+/// release (docs/faults.md).
+const CHECK_FAULT_AFTER_RELEASE: bool = true;
 
 /// Where a delivered frame came from: what decides whether a release in it is legitimate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -322,9 +322,9 @@ fn fast() -> Script {
         .op(Op::Release, &[0])
 }
 
-/// A latch and a release while a fault holds: STOP and a new key then start a motion
-/// although the cause remains (see the oracle's `CHECK_FAULT_AFTER_RELEASE`). Here the
-/// SYNC froze before the latch and stays frozen.
+/// A latch and a release while a fault holds: STOP and a new key must start no motion while
+/// the cause remains (the oracle's `CHECK_FAULT_AFTER_RELEASE`). Here the SYNC froze before
+/// the latch and stays frozen.
 fn sync_fault() -> Script {
     use mode::*;
     plant(Script::new(HZ_250, None, 0))

@@ -4,7 +4,7 @@
 use protocol::FaultFlags;
 
 use super::{Controller, Status};
-use crate::control::fsm::State;
+use crate::control::fsm::{Event, State};
 use crate::time::Tick;
 
 impl Controller {
@@ -57,5 +57,16 @@ impl Controller {
             faults = faults.with(FaultFlags::SYNC_LOST);
         }
         faults
+    }
+
+    /// `Fault` while a cause that only `Fault` holds remains — a drive's reported fault, a
+    /// SYNC that froze — checked as a level, not only when it is first reported: an E-stop
+    /// outranks a fault, so a cause reported while latched would otherwise be forgotten by
+    /// the release, which would reset it without the check a STOP in `Fault` makes.
+    pub(super) fn fault_on_held_cause(&mut self) {
+        let held = self.drive_faults.iter().any(|&faulted| faulted) || self.clock_stalled;
+        if held && !matches!(self.state, State::EStop | State::Fault) {
+            self.apply(Event::Fault);
+        }
     }
 }
