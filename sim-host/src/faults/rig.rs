@@ -120,7 +120,7 @@ impl Rig {
     ) -> Result<Self, SessionError> {
         let sim = Simulator::new(model, RIG_HZ, StartPose::standing(), plant)?;
         let bus = InprocBus::new();
-        let sim_bus = FaultyBus::new(bus.endpoint(), faults);
+        let sim_bus = FaultyBus::new(bus.endpoint(), &plant.link_faults(faults));
         let firmware = firmware_config(RIG_HZ).ok_or(SessionError::ControlRate(RIG_HZ))?;
         let session = Session::owned(TEST_KEY, RIG_EPOCH);
         let controller = InprocController::new(firmware, bus.endpoint(), session)

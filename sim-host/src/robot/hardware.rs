@@ -34,9 +34,14 @@ impl Hardware {
     pub fn new(control_hz: u32, plant: Plant, leg_range_rad: &Joints<[f64; 2]>, key: Key) -> Self {
         let rating = plant.drives.leg_joint;
         Self {
-            legs: Leg::ALL
-                .map(|leg| LegDrive::new(leg, *leg_range_rad.leg(leg), key).rated(rating)),
-            wheel: WheelDrive::new(key).rated(plant.drives.wheel),
+            legs: Leg::ALL.map(|leg| {
+                LegDrive::new(leg, *leg_range_rad.leg(leg), key)
+                    .rated(rating)
+                    .sensing(&plant.sensing)
+            }),
+            wheel: WheelDrive::new(key)
+                .rated(plant.drives.wheel)
+                .sensing(&plant.sensing),
             imu: ImuNode::new(plant.imu_noise, key),
             control_hz,
             controller_mode: None,

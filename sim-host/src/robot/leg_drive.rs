@@ -1,7 +1,8 @@
 //! One leg's drive: four position servos that take their targets from the controller's
 //! `LegTargets` frame, close the position loop themselves (the report's stiffness, kp
 //! 180/200/260/160 N·m/rad) on torque motors of a real rating ([`Rating::LEG_JOINT`]), and
-//! report joint position, velocity and applied torque in a `LegFeedback` frame.
+//! report what they measure of each joint (its encoder's angle and count velocity, the torque
+//! from the phase current: [`crate::robot::sensing`]) in a `LegFeedback` frame.
 //!
 //! Like a real servo drive it enforces its own limits whatever the wire says: a target outside
 //! a joint's range (the model's `range`, the leg's mechanical stops) is clamped to it and the
@@ -10,13 +11,13 @@
 //! ([`protocol::DriveFlags::SATURATED`]).
 
 use protocol::{
-    Angle, AnyMessage, DriveEnable, Frame, JointVelocity, Joints, Leg, LegFeedback, MessageId,
-    Torque,
+    Angle, AnyMessage, DriveEnable, Frame, JointVelocity, Leg, LegFeedback, MessageId, Torque,
 };
 
 use crate::robot::drive_core::{Authority, DriveCore};
 use crate::robot::physics::Physics;
 use crate::robot::rating::{Limiter, Rating};
+use crate::robot::sensing::{DriveSensing, Encoder};
 
 /// The servos' stiffness, N·m/rad, per joint (hip abduction, hip pitch, knee, ankle): the
 /// report's position actuators.
@@ -33,6 +34,8 @@ pub struct LegDrive {
     limiters: [Limiter; 4],
     /// Physics steps in which a joint's torque was cut to the rating.
     saturated_steps: u64,
+    encoders: [Encoder; 4],
+    effort_gains: [f64; 4],
 }
 
 impl LegDrive {
@@ -50,7 +53,16 @@ impl LegDrive {
             clamped: 0,
             limiters: [Limiter::new(Rating::LEG_JOINT); 4],
             saturated_steps: 0,
+            encoders: [Encoder::new(None); 4],
+            effort_gains: [1.0; 4],
         }
+    }
+
+    /// The drive measuring its joints as `sensing` says (default: exactly).
+    pub fn sensing(mut self, sensing: &DriveSensing) -> Self {
+        self.encoders = [Encoder::new(sensing.leg_counts_per_turn); 4];
+        self.effort_gains = sensing.effort_gains(self.leg as u64);
+        self
     }
 
     /// The drive with its joints' motors of `rating` (default [`Rating::LEG_JOINT`]).
@@ -106,19 +118,24 @@ impl LegDrive {
         }
     }
 
-    /// Runs the leg's servos for the next physics step: the position loop's torque, limited
-    /// to the rating, or none when the drive is torque-off.
+    /// Samples the encoders and runs the leg's servos for the next physics step: the position
+    /// loop's torque on the measured angle, limited to the rating, or none when the drive is
+    /// torque-off.
     pub fn apply(&mut self, now_us: u64, physics: &mut Physics) {
         let leg = self.leg as usize;
         let dt_s = physics.timestep_s();
+        let speeds = *physics.leg_velocities_rad_s().leg(self.leg);
+        let angles = *physics.leg_positions_rad().leg(self.leg);
+        for ((encoder, angle), speed) in self.encoders.iter_mut().zip(angles).zip(speeds) {
+            encoder.sample(angle, speed, dt_s);
+        }
         match self.core.authority(now_us) {
             Authority::Drive => {
-                let angles = *physics.leg_positions_rad().leg(self.leg);
-                let speeds = *physics.leg_velocities_rad_s().leg(self.leg);
                 let mut torques = [0.0; 4];
                 let mut saturated = false;
                 for (i, limiter) in self.limiters.iter_mut().enumerate() {
-                    let wanted = SERVO_KP_NM_RAD[i] * (self.targets_rad[i] - angles[i]);
+                    let measured_rad = self.encoders[i].angle_rad();
+                    let wanted = SERVO_KP_NM_RAD[i] * (self.targets_rad[i] - measured_rad);
                     let limited = limiter.limit(wanted, speeds[i], dt_s);
                     torques[i] = limited.torque_nm;
                     saturated |= limited.saturated;
@@ -139,21 +156,29 @@ impl LegDrive {
         }
     }
 
-    /// The feedback frame for the current state.
+    /// The feedback frame: the encoders' last sample, the applied torques as the drive
+    /// measures them.
     pub fn feedback(&mut self, physics: &Physics) -> AnyMessage {
-        let pick = |all: Joints<f64>| -> [f32; 4] { all.leg(self.leg).map(|v| v as f32) };
-        let efforts = if physics.leg_enabled(self.leg as usize) {
-            pick(physics.leg_efforts_nm())
-        } else {
-            [0.0; 4]
-        };
+        let efforts_nm = *physics.leg_efforts_nm().leg(self.leg);
+        let enabled = physics.leg_enabled(self.leg as usize);
+        let effort = std::array::from_fn(|i| {
+            let nm = if enabled {
+                efforts_nm[i] * self.effort_gains[i]
+            } else {
+                0.0
+            };
+            Torque::saturating_from_si(nm as f32)
+        });
         AnyMessage::LegFeedback(
             self.leg,
             LegFeedback {
-                position: pick(physics.leg_positions_rad()).map(Angle::saturating_from_si),
-                velocity: pick(physics.leg_velocities_rad_s())
-                    .map(JointVelocity::saturating_from_si),
-                effort: efforts.map(Torque::saturating_from_si),
+                position: self
+                    .encoders
+                    .map(|e| Angle::saturating_from_si(e.angle_rad() as f32)),
+                velocity: self
+                    .encoders
+                    .map(|e| JointVelocity::saturating_from_si(e.velocity_rad_s() as f32)),
+                effort,
             },
         )
     }

@@ -1,6 +1,7 @@
 //! The robot: its MuJoCo [`model`] and [`physics`] (ground truth), and the hardware a real
 //! robot puts on the bus, emulated — four [`leg_drive`]s and the [`wheel_drive`] (sharing
-//! [`drive_core`], each at its [`rating`]), the [`imu`], all together in [`hardware`].
+//! [`drive_core`], each at its [`rating`], measuring as [`sensing`] says), the [`imu`], all
+//! together in [`hardware`]; the [`plant`] picks the parts.
 
 pub mod drive_core;
 pub mod hardware;
@@ -11,5 +12,6 @@ pub mod model;
 pub mod physics;
 pub mod plant;
 pub mod rating;
+pub mod sensing;
 pub mod variation;
 pub mod wheel_drive;

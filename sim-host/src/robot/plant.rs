@@ -1,9 +1,12 @@
 //! What the emulated hardware is made of, for a run: the IMU's noise, the drives' ratings and
-//! how the body differs from the model.
+//! sensing, the bus's transport delay, and how the body differs from the model.
 //! The tested default is [`Plant::default`]; the ideal parts stay for debugging a controller.
+
+use host_can::fault_plan::Faults;
 
 use crate::robot::imu::ImuNoise;
 use crate::robot::rating::Rating;
+use crate::robot::sensing::DriveSensing;
 use crate::robot::variation::Variation;
 
 /// The ratings the drives enforce.
@@ -37,8 +40,28 @@ pub struct Plant {
     pub imu_noise: ImuNoise,
     /// What the drives can deliver.
     pub drives: DriveRatings,
+    /// How the drives measure their joints.
+    pub sensing: DriveSensing,
+    /// Control cycles each frame between the simulator's nodes and the controller is held
+    /// back, each way: the CAN loop's transport delay (lockstep has none of its own; a real
+    /// loop has a sample, a transfer and a command transfer).
+    pub transport_delay_cycles: u32,
     /// How this robot's body differs from the model's.
     pub variation: Variation,
+}
+
+impl Plant {
+    /// `faults` on the simulator's connection with this plant's transport delay added to
+    /// both directions (SYNC stays undelayed, as every fault leaves it).
+    pub fn link_faults(&self, faults: &Faults) -> Faults {
+        let mut faults = faults.clone();
+        for plan in [&mut faults.tx, &mut faults.rx] {
+            plan.delay_cycles = plan
+                .delay_cycles
+                .saturating_add(self.transport_delay_cycles);
+        }
+        faults
+    }
 }
 
 impl Default for Plant {
@@ -50,6 +73,8 @@ impl Default for Plant {
         Self {
             imu_noise: ImuNoise::default(),
             drives: DriveRatings::IDEAL,
+            sensing: DriveSensing::IDEAL,
+            transport_delay_cycles: 0,
             variation: Variation::NOMINAL,
         }
     }

@@ -1,5 +1,7 @@
 //! The wheel drive: two torque-controlled motors (the report's motor actuators, gear 1) that
-//! take `WheelCommand` frames and report speed and applied torque in `WheelFeedback`.
+//! take `WheelCommand` frames and report what they measure (each wheel's encoder count
+//! velocity and the torque from the phase current: [`crate::robot::sensing`]) in
+//! `WheelFeedback`.
 //!
 //! Like a real drive it enforces its rating whatever the wire says: a commanded torque above
 //! the peak ([`WHEEL_PEAK_TORQUE_NM`]) is clamped to it and the command counted
@@ -11,6 +13,7 @@ use protocol::{AnyMessage, Frame, MessageId, Torque, WheelFeedback, WheelVelocit
 use crate::robot::drive_core::{Authority, DriveCore};
 use crate::robot::physics::Physics;
 use crate::robot::rating::{Limiter, Rating};
+use crate::robot::sensing::{DriveSensing, Encoder};
 
 /// The wheel motors' peak torque, N·m ([`Rating::WHEEL`]).
 pub const WHEEL_PEAK_TORQUE_NM: f64 = Rating::WHEEL.peak_torque_nm;
@@ -26,6 +29,8 @@ pub struct WheelDrive {
     applied_nm: [f64; 2],
     /// Physics steps in which a wheel's torque was cut to the rating.
     saturated_steps: u64,
+    encoders: [Encoder; 2],
+    effort_gains: [f64; 2],
 }
 
 impl WheelDrive {
@@ -38,7 +43,17 @@ impl WheelDrive {
             limiters: [Limiter::new(Rating::WHEEL); 2],
             applied_nm: [0.0; 2],
             saturated_steps: 0,
+            encoders: [Encoder::new(None); 2],
+            effort_gains: [1.0; 2],
         }
+    }
+
+    /// The drive measuring its wheels as `sensing` says (default: exactly).
+    pub fn sensing(mut self, sensing: &DriveSensing) -> Self {
+        self.encoders = [Encoder::new(sensing.wheel_counts_per_turn); 2];
+        // Stream 4: after the four legs' 0…3.
+        self.effort_gains = sensing.effort_gains(4);
+        self
     }
 
     /// The drive with motors of `rating` (default [`Rating::WHEEL`]); commands stay clamped to
@@ -91,10 +106,14 @@ impl WheelDrive {
         self.applied_nm
     }
 
-    /// Drives the wheel motors in the simulation for the next step.
+    /// Samples the encoders and drives the wheel motors in the simulation for the next step.
     pub fn apply(&mut self, now_us: u64, physics: &mut Physics) {
         let dt_s = physics.timestep_s();
         let speeds = physics.wheel_velocities_rad_s();
+        let angles = physics.wheel_positions_rad();
+        for ((encoder, angle), speed) in self.encoders.iter_mut().zip(angles).zip(speeds) {
+            encoder.sample(angle, speed, dt_s);
+        }
         let on = self.core.authority(now_us) == Authority::Drive;
         let mut saturated = false;
         for (i, limiter) in self.limiters.iter_mut().enumerate() {
@@ -114,15 +133,17 @@ impl WheelDrive {
         physics.set_wheel_torques(self.applied_nm);
     }
 
-    /// The feedback frame for the current state.
+    /// The feedback frame: the encoders' count velocities, the applied torques as the drive
+    /// measures them.
     pub fn feedback(&mut self, physics: &Physics) -> AnyMessage {
+        let efforts_nm = physics.wheel_efforts_nm();
         AnyMessage::WheelFeedback(WheelFeedback {
-            velocity: physics
-                .wheel_velocities_rad_s()
-                .map(|v| WheelVelocity::saturating_from_si(v as f32)),
-            effort: physics
-                .wheel_efforts_nm()
-                .map(|t| Torque::saturating_from_si(t as f32)),
+            velocity: self
+                .encoders
+                .map(|e| WheelVelocity::saturating_from_si(e.velocity_rad_s() as f32)),
+            effort: std::array::from_fn(|i| {
+                Torque::saturating_from_si((efforts_nm[i] * self.effort_gains[i]) as f32)
+            }),
         })
     }
 }

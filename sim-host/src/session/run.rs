@@ -86,7 +86,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         period_us: 1_000_000 / u64::from(config.control_hz.max(1)),
         counters,
     };
-    let mut sim_bus = FaultyBus::new(nodes.sim, &config.faults);
+    let mut sim_bus = FaultyBus::new(nodes.sim, &config.plant.link_faults(&config.faults));
     let stats = drive(
         &mut sim,
         &mut sim_bus,

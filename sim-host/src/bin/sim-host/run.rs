@@ -11,6 +11,7 @@ use host_can::fault_plan::Faults;
 use sim_host::robot::imu::ImuNoise;
 use sim_host::robot::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
 use sim_host::robot::plant::{DriveRatings, Plant};
+use sim_host::robot::sensing::DriveSensing;
 use sim_host::robot::variation::Variation;
 use sim_host::session::{self, BusChoice, Clock, FrameSettings, SegmentSpec, SessionConfig};
 use teleop_core::scenario::{mode_name, Scenario};
@@ -33,6 +34,15 @@ pub(crate) enum DrivesArg {
     /// Real parts' ratings: peak, torque-speed line, thermal foldback.
     Rated,
     /// No torque limit on the legs, a flat 30 N·m on the wheels (for debugging).
+    Ideal,
+}
+
+/// How the emulated drives measure their joints.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum SensingArg {
+    /// Named parts: counted encoders, velocity from counts, effort with gain error.
+    Real,
+    /// MuJoCo's exact joint state (for debugging).
     Ideal,
 }
 
@@ -112,6 +122,16 @@ pub(crate) struct RunArgs {
     /// controller copes with rated drives.
     #[arg(long, value_enum, default_value_t = DrivesArg::Ideal)]
     pub(crate) drives: DrivesArg,
+    /// How the drives measure their joints: `real` (14-bit encoders, velocity from count
+    /// differences, effort within ±5 % gain error; see docs/simulator.md) or `ideal` (MuJoCo's
+    /// exact state).
+    #[arg(long, value_enum, default_value_t = SensingArg::Ideal)]
+    pub(crate) sensing: SensingArg,
+    /// Control cycles every frame between the simulator's nodes and the controller is held
+    /// back, each way: the CAN loop's transport delay, on top of what the bus itself takes
+    /// (nothing in lockstep).
+    #[arg(long, default_value_t = 0, value_parser = clap::value_parser!(u32).range(0..=50))]
+    pub(crate) delay_cycles: u32,
     /// Skip the PNG plots.
     #[arg(long)]
     pub(crate) no_plots: bool,
@@ -269,6 +289,11 @@ fn session_config(args: &RunArgs, scenario: Option<&Scenario>, duration_s: f64) 
                 DrivesArg::Rated => DriveRatings::RATED,
                 DrivesArg::Ideal => DriveRatings::IDEAL,
             },
+            sensing: match args.sensing {
+                SensingArg::Real => DriveSensing::REAL,
+                SensingArg::Ideal => DriveSensing::IDEAL,
+            },
+            transport_delay_cycles: args.delay_cycles,
             variation: Variation::NOMINAL,
         },
         teleop_plan,
