@@ -142,15 +142,11 @@ impl StopConfig {
     }
 }
 
-/// A joint-space move from one pose to another over a whole number of ticks, with a smoothstep
-/// profile (zero joint rate at both ends; the peak rate is 1.5 times the mean), the front legs
-/// swung out by a bump of abduction that is zero at both ends.
+/// A [`legs::ramp::Ramp`](crate::legs::ramp::Ramp) with the front legs swung out by a bump of
+/// abduction that is zero at both ends (clear of the wheels on the way into the kickstand).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Ramp {
-    from: Joints<f32>,
-    to: Joints<f32>,
-    start: Tick,
-    ticks: u32,
+    ramp: crate::legs::ramp::Ramp,
     spread_rad: f32,
 }
 
@@ -164,26 +160,18 @@ impl Ramp {
         rate: TickRate,
     ) -> Self {
         Self {
-            from,
-            to,
-            start,
-            ticks: ramp_ticks(&from, &to, peak_rate_rad_s, rate),
+            ramp: crate::legs::ramp::Ramp::new(from, to, start, peak_rate_rad_s, rate),
             spread_rad: 0.0,
         }
     }
 
     /// The pose at `now`, and whether the ramp is over.
     fn at(&self, now: Tick) -> (Joints<f32>, bool) {
-        let elapsed = now.since(self.start);
-        if elapsed >= self.ticks {
-            return (self.to, true);
+        let (mut pose, done) = self.ramp.at(now);
+        if done {
+            return (pose, true);
         }
-        let s = elapsed as f32 / self.ticks as f32;
-        let blend = s * s * (3.0 - 2.0 * s);
-        let mut pose = self.from;
-        for (joint, goal) in pose.iter_mut().zip(self.to.iter()) {
-            *joint += blend * (goal - *joint);
-        }
+        let s = self.ramp.progress(now);
         // Abduction is about +x: outward is positive on the left, negative on the right.
         let spread = self.spread_rad * 4.0 * s * (1.0 - s);
         if let Some(fl) = pose.leg_mut(Leg::Fl).first_mut() {
@@ -237,11 +225,9 @@ fn kickstand_ramp(
     elapsed: u32,
     spread_rad: f32,
 ) -> Ramp {
+    let ticks = last_ramp_ticks(config, rate, elapsed);
     Ramp {
-        from,
-        to: config.kickstand(),
-        start: now,
-        ticks: last_ramp_ticks(config, rate, elapsed),
+        ramp: crate::legs::ramp::Ramp::over(from, config.kickstand(), now, ticks),
         spread_rad,
     }
 }
@@ -394,7 +380,8 @@ impl Stop {
                 let (pose, done) = ramp.at(now);
                 (
                     StopCommand::Servo(pose),
-                    done.then_some(Phase::Settle(now, ramp.to)),
+                    // Done, the pose is the ramp's goal.
+                    done.then_some(Phase::Settle(now, pose)),
                 )
             }
             Phase::Settle(since, pose) => {
