@@ -238,15 +238,19 @@ fn the_wheel_drive_applies_the_commanded_torque_and_reports_it() {
     let c = ctl.borrow();
     let fb = c.wheel_feedback.expect("wheel feedback");
     let effort = fb.effort.map(|t| t.si());
+    // As the drive measures it: within its gain error (5 %) and the field's 0.01 N·m.
+    let within = |measured: f32, applied: f32| (measured - applied).abs() <= 0.05 * 1.5 + 0.011;
     assert!(
-        (effort[0] - 1.5).abs() < 0.011 && (effort[1] + 1.5).abs() < 0.011,
+        within(effort[0], 1.5) && within(effort[1], -1.5),
         "{effort:?}"
     );
     // Standing on its legs, the wheels spin freely in opposite directions, up to the speed
-    // where the report's joint damping (2 N·m·s/rad) eats the torque: 1.5 / 2 = 0.75 rad/s.
+    // where the report's joint damping (2 N·m·s/rad) eats the torque: 1.5 / 2 = 0.75 rad/s,
+    // as the drive counts it (one count of its encoder in a 4 ms cycle is 0.096 rad/s).
     let speed = fb.velocity.map(|v| v.si());
+    let tolerance = 0.03 + 0.096;
     assert!(
-        (speed[0] - 0.75).abs() < 0.03 && (speed[1] + 0.75).abs() < 0.03,
+        (speed[0] - 0.75).abs() < tolerance && (speed[1] + 0.75).abs() < tolerance,
         "{speed:?}"
     );
 }

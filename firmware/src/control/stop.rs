@@ -62,7 +62,8 @@
 //! 0.54 m/s into the 6 cm step, the robot stays within 12 cm of where it met the step
 //! (`sim-host/tests/stall.rs`).
 //!
-//! Whatever remains undone one tick before [`SS1_DEADLINE_MS`] after the latch is cut then: the
+//! Whatever remains undone [`StopConfig::cut_margin_ms`] and a tick before [`SS1_DEADLINE_MS`]
+//! after the latch is cut then (the margin lets the command cross the bus in time): the
 //! drives start their own timer of the same length on the latch frame and cut torque when it
 //! ends, so the controller's stop must be over by then. A robot doing nothing (`Hold`), already
 //! in `Fault`, or not yet armed is cut at once; any fault cause during the sequence (a drive
@@ -90,6 +91,10 @@ pub struct StopConfig {
     pub rest_speed_m_s: f32,
     /// How long the kickstand pose is held, balancing, before the torque goes, ms.
     pub settle_ms: u32,
+    /// How long before [`SS1_DEADLINE_MS`] the controller commands torque off, ms: the
+    /// command has to reach the drives by the deadline through the bus's transport delay (a
+    /// cycle or two), whatever the drives' own timers do.
+    pub cut_margin_ms: u32,
     /// Outward hip abduction of the front legs midway through the kickstand from the wheels,
     /// rad (none at either end). Their feet pass under the hips on the way to the stops, 9 cm
     /// deeper than the wheels in the leg plane: swung out sideways they pass 1 to 2 cm deep
@@ -113,6 +118,7 @@ impl StopConfig {
         kickstand_rate_rad_s: 3.0,
         rest_speed_m_s: 0.02,
         settle_ms: 100,
+        cut_margin_ms: 20,
         kickstand_spread_rad: deg_to_rad(34.0),
         wheel_hold_nm_per_rad_s: 10.0,
         kickstand_front: LegJoints {
@@ -199,17 +205,20 @@ pub enum Carrier {
 }
 
 /// Ticks from the latch at which the controller cuts the torque whatever the sequence has done:
-/// one tick before [`SS1_DEADLINE_MS`], since the controller may hear the latch frame a tick
-/// after the drives, which time their own cut from it.
-fn cut_ticks(rate: TickRate) -> u32 {
-    rate.ticks_from_ms(SS1_DEADLINE_MS).saturating_sub(1)
+/// [`StopConfig::cut_margin_ms`] before [`SS1_DEADLINE_MS`], and a tick more, since the
+/// controller may hear the latch frame a tick after the drives, which time their own cut from
+/// it.
+fn cut_ticks(config: &StopConfig, rate: TickRate) -> u32 {
+    let margin_ms = config.cut_margin_ms.min(SS1_DEADLINE_MS);
+    rate.ticks_from_ms(SS1_DEADLINE_MS - margin_ms)
+        .saturating_sub(1)
 }
 
 /// Length of a kickstand ramp started `elapsed` ticks after the latch that ends, with the settle
 /// time after it, at the cut: as slow as the deadline allows, since the torso's motion scales
 /// with the joints'.
 fn last_ramp_ticks(config: &StopConfig, rate: TickRate, elapsed: u32) -> u32 {
-    cut_ticks(rate)
+    cut_ticks(config, rate)
         .saturating_sub(elapsed)
         .saturating_sub(rate.ticks_from_ms(config.settle_ms))
         .saturating_sub(1)
@@ -353,7 +362,7 @@ impl Stop {
     /// One tick of the stop.
     pub fn step(&mut self, input: &StopInput) -> StopCommand {
         let now = input.now;
-        if input.fault || now.since(self.latched) >= cut_ticks(self.rate) {
+        if input.fault || now.since(self.latched) >= cut_ticks(&self.config, self.rate) {
             self.phase = Phase::Off;
         }
         let (command, next) = match self.phase {
@@ -401,6 +410,6 @@ impl Stop {
     fn kickstand_due(&self, now: Tick) -> bool {
         now.since(self.latched)
             .saturating_add(self.kickstand_needed)
-            >= cut_ticks(self.rate)
+            >= cut_ticks(&self.config, self.rate)
     }
 }

@@ -124,13 +124,11 @@ impl LegDrive {
     pub fn apply(&mut self, now_us: u64, physics: &mut Physics) {
         let leg = self.leg as usize;
         let dt_s = physics.timestep_s();
-        let speeds = *physics.leg_velocities_rad_s().leg(self.leg);
-        let angles = *physics.leg_positions_rad().leg(self.leg);
-        for ((encoder, angle), speed) in self.encoders.iter_mut().zip(angles).zip(speeds) {
-            encoder.sample(angle, speed, dt_s);
-        }
+        self.sense(physics);
         match self.core.authority(now_us) {
             Authority::Drive => {
+                // The motor's back-EMF follows the true speed.
+                let speeds = *physics.leg_velocities_rad_s().leg(self.leg);
                 let mut torques = [0.0; 4];
                 let mut saturated = false;
                 for (i, limiter) in self.limiters.iter_mut().enumerate() {
@@ -156,9 +154,20 @@ impl LegDrive {
         }
     }
 
-    /// The feedback frame: the encoders' last sample, the applied torques as the drive
+    /// Samples the encoders (once per simulated instant, see [`Encoder::sample`]).
+    fn sense(&mut self, physics: &Physics) {
+        let speeds = *physics.leg_velocities_rad_s().leg(self.leg);
+        let angles = *physics.leg_positions_rad().leg(self.leg);
+        let time_s = physics.time_s();
+        for ((encoder, angle), speed) in self.encoders.iter_mut().zip(angles).zip(speeds) {
+            encoder.sample(angle, speed, time_s);
+        }
+    }
+
+    /// The feedback frame: the encoders' sample now, the applied torques as the drive
     /// measures them.
     pub fn feedback(&mut self, physics: &Physics) -> AnyMessage {
+        self.sense(physics);
         let efforts_nm = *physics.leg_efforts_nm().leg(self.leg);
         let enabled = physics.leg_enabled(self.leg as usize);
         let effort = std::array::from_fn(|i| {

@@ -65,15 +65,16 @@ impl Plant {
 }
 
 impl Default for Plant {
-    /// The tested default. The ideal drives until every acceptance scenario has been run on
-    /// [`DriveRatings::RATED`]: the report's fold needed 74 N·m at the hips and ran the robot
-    /// away; the fold in place, W and the stand-up into a trot now each pass a single run on
-    /// rated drives.
+    /// The tested default: the drives measure with real encoders ([`DriveSensing::REAL`]).
+    /// Still ideal drive ratings and no transport delay: on rated drives a trot after S
+    /// presses a hip 1° past its range, and with a cycle of delay the drives hear an E-stop
+    /// latch a cycle late (their own cut then comes after the deadline; the wheel command
+    /// has no torque-off to send earlier).
     fn default() -> Self {
         Self {
             imu_noise: ImuNoise::default(),
             drives: DriveRatings::IDEAL,
-            sensing: DriveSensing::IDEAL,
+            sensing: DriveSensing::REAL,
             transport_delay_cycles: 0,
             variation: Variation::NOMINAL,
         }

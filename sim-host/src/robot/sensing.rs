@@ -11,9 +11,10 @@
 //!   16,384 counts per turn, 3.8e-4 rad per count.
 //! - **Velocity**: the count difference between two consecutive samples of the drive's
 //!   encoder over the time between them, as a drive without an observer computes it. The
-//!   drive samples once a physics step (the finest clock the simulation has): one count in a
-//!   4 ms step is 0.0105 rad/s on a leg joint and 0.096 rad/s (1.2 cm/s of ground speed) on a
-//!   wheel, and the value lags the true speed by half a step.
+//!   drive samples when it reports and when it closes its loop, at most once per simulated
+//!   instant (once a control cycle here): one count in 4 ms is 0.0105 rad/s on a leg joint and
+//!   0.096 rad/s (1.2 cm/s of ground speed) on a wheel, and the value lags the true speed by
+//!   half a cycle.
 //! - **Effort**: the torque the motor applied times (1 + gain error), the error the drive's
 //!   torque constant and current sense leave: drawn once per joint, uniform within
 //!   ±[`DriveSensing::effort_gain_error`] (5 % by default, the spread of a motor's torque
@@ -79,8 +80,8 @@ impl DriveSensing {
 pub struct Encoder {
     /// Radians per count; `None`: exact.
     count_rad: Option<f64>,
-    /// The last sample's count, and the measured angle and velocity.
-    last_count: Option<i64>,
+    /// The last sample's time (s) and count, and the measured angle and velocity.
+    last: Option<(f64, i64)>,
     angle_rad: f64,
     velocity_rad_s: f64,
 }
@@ -92,27 +93,32 @@ impl Encoder {
             count_rad: counts_per_turn
                 .filter(|counts| counts.is_finite() && *counts > 0.0)
                 .map(|counts| std::f64::consts::TAU / counts),
-            last_count: None,
+            last: None,
             angle_rad: 0.0,
             velocity_rad_s: 0.0,
         }
     }
 
-    /// Samples the joint at `angle_rad` (true velocity `velocity_rad_s`, used by an exact
-    /// encoder and for the very first sample), `dt_s` after the previous sample.
-    pub fn sample(&mut self, angle_rad: f64, velocity_rad_s: f64, dt_s: f64) {
+    /// Samples the joint at `angle_rad` at simulated time `time_s` (true velocity
+    /// `velocity_rad_s`, used by an exact encoder and for the very first sample). A second
+    /// sample at the same time changes nothing, so every user of the drive's measurement may
+    /// ask for it first.
+    pub fn sample(&mut self, angle_rad: f64, velocity_rad_s: f64, time_s: f64) {
         let Some(count_rad) = self.count_rad else {
             self.angle_rad = angle_rad;
             self.velocity_rad_s = velocity_rad_s;
             return;
         };
         let count = (angle_rad / count_rad).floor() as i64;
+        match self.last {
+            Some((last_s, _)) if time_s == last_s => return,
+            Some((last_s, last_count)) if time_s > last_s => {
+                self.velocity_rad_s = (count - last_count) as f64 * count_rad / (time_s - last_s);
+            }
+            _ => self.velocity_rad_s = velocity_rad_s,
+        }
         self.angle_rad = count as f64 * count_rad;
-        self.velocity_rad_s = match self.last_count {
-            Some(last) if dt_s > 0.0 => (count - last) as f64 * count_rad / dt_s,
-            _ => velocity_rad_s,
-        };
-        self.last_count = Some(count);
+        self.last = Some((time_s, count));
     }
 
     /// The angle of the last sample's count, rad.
@@ -134,9 +140,16 @@ mod tests {
     fn a_count_difference_gives_the_mean_speed_in_whole_counts() {
         let mut encoder = Encoder::new(Some(16_384.0));
         let count_rad = std::f64::consts::TAU / 16_384.0;
-        encoder.sample(0.1, 0.0, 0.004);
+        encoder.sample(0.1, 0.0, 0.0);
         // 0.5 rad/s for 4 ms is 2 mrad: 5.2 counts, seen as 5 or 6.
         encoder.sample(0.1 + 0.002, 0.5, 0.004);
+        let velocity = encoder.velocity_rad_s();
+        encoder.sample(0.2, 9.0, 0.004);
+        assert_eq!(
+            encoder.velocity_rad_s(),
+            velocity,
+            "a second sample at one time"
+        );
         let counts = encoder.velocity_rad_s() * 0.004 / count_rad;
         assert!((counts - counts.round()).abs() < 1e-9, "{counts}");
         assert!((5.0..=6.0).contains(&counts.round()), "{counts}");
@@ -146,7 +159,7 @@ mod tests {
     #[test]
     fn an_exact_encoder_reports_the_truth_and_gains_stay_in_their_bound() {
         let mut encoder = Encoder::new(None);
-        encoder.sample(0.123_456, 1.5, 0.004);
+        encoder.sample(0.123_456, 1.5, 0.0);
         assert_eq!(
             (encoder.angle_rad(), encoder.velocity_rad_s()),
             (0.123_456, 1.5)

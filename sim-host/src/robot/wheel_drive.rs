@@ -110,10 +110,7 @@ impl WheelDrive {
     pub fn apply(&mut self, now_us: u64, physics: &mut Physics) {
         let dt_s = physics.timestep_s();
         let speeds = physics.wheel_velocities_rad_s();
-        let angles = physics.wheel_positions_rad();
-        for ((encoder, angle), speed) in self.encoders.iter_mut().zip(angles).zip(speeds) {
-            encoder.sample(angle, speed, dt_s);
-        }
+        self.sense(physics);
         let on = self.core.authority(now_us) == Authority::Drive;
         let mut saturated = false;
         for (i, limiter) in self.limiters.iter_mut().enumerate() {
@@ -133,9 +130,20 @@ impl WheelDrive {
         physics.set_wheel_torques(self.applied_nm);
     }
 
-    /// The feedback frame: the encoders' count velocities, the applied torques as the drive
-    /// measures them.
+    /// Samples the encoders (once per simulated instant, see [`Encoder::sample`]).
+    fn sense(&mut self, physics: &Physics) {
+        let speeds = physics.wheel_velocities_rad_s();
+        let angles = physics.wheel_positions_rad();
+        let time_s = physics.time_s();
+        for ((encoder, angle), speed) in self.encoders.iter_mut().zip(angles).zip(speeds) {
+            encoder.sample(angle, speed, time_s);
+        }
+    }
+
+    /// The feedback frame: the encoders' count velocities now, the applied torques as the
+    /// drive measures them.
     pub fn feedback(&mut self, physics: &Physics) -> AnyMessage {
+        self.sense(physics);
         let efforts_nm = physics.wheel_efforts_nm();
         AnyMessage::WheelFeedback(WheelFeedback {
             velocity: self

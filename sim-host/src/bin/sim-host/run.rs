@@ -124,8 +124,8 @@ pub(crate) struct RunArgs {
     pub(crate) drives: DrivesArg,
     /// How the drives measure their joints: `real` (14-bit encoders, velocity from count
     /// differences, effort within ±5 % gain error; see docs/simulator.md) or `ideal` (MuJoCo's
-    /// exact state).
-    #[arg(long, value_enum, default_value_t = SensingArg::Ideal)]
+    /// exact state, for debugging).
+    #[arg(long, value_enum, default_value_t = SensingArg::Real)]
     pub(crate) sensing: SensingArg,
     /// Control cycles every frame between the simulator's nodes and the controller is held
     /// back, each way: the CAN loop's transport delay, on top of what the bus itself takes
