@@ -109,7 +109,7 @@ impl Config {
             trim_time_constant_s: 2.0,
             trim_range_rad: crate::math::deg_to_rad(15.0),
             accel_limit_m_s2: 0.35,
-            brake_limit_m_s2: 0.8,
+            brake_limit_m_s2: 1.2,
             wheel_viscous_nm_per_rad_s: 2.0,
         },
         feedback_timeout_ms: 40,

@@ -72,9 +72,9 @@ fn lqr(a: &Matrix4<f64>, b: &Matrix4x1<f64>, q: &Matrix4<f64>, r: f64) -> [f64; 
 fn bryson() -> (Matrix4<f64>, f64) {
     let weight = |largest: f64| 1.0 / (largest * largest);
     let q = Matrix4::from_diagonal(&nalgebra::Vector4::new(
+        weight(0.15),
         weight(0.1),
-        weight(0.1),
-        weight(0.2),
+        weight(0.3),
         weight(1.0),
     ));
     (q, weight(30.0))

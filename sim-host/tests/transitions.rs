@@ -115,7 +115,7 @@ fn the_fold_right_after_a_trot_happens_in_place() {
         let before = [(0.0, TeleopMode::Stop), (0.1, trot)];
         assert_in_place(
             &transition(what, &before, TeleopMode::Fold, 4.0),
-            0.075,
+            0.05,
             tilt_deg,
         );
     }
@@ -125,5 +125,5 @@ fn the_fold_right_after_a_trot_happens_in_place() {
 fn standing_up_from_the_wheels_happens_in_place() {
     let before = [(0.0, TeleopMode::Stop), (0.1, TeleopMode::Fold)];
     let f = transition("stand-up from the wheels", &before, TeleopMode::Stand, 6.0);
-    assert_in_place(&f, 0.13, 10.0);
+    assert_in_place(&f, 0.145, 10.0);
 }

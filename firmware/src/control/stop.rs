@@ -14,7 +14,7 @@
 //!
 //! 1. **Brake** — the balance law keeps running with a zero speed reference, which the law
 //!    ramps down at its brake limit
-//!    ([`crate::wheels::balance::BalanceConfig::brake_limit_m_s2`], 0.8 m/s², the same as a
+//!    ([`crate::wheels::balance::BalanceConfig::brake_limit_m_s2`], 1.2 m/s², the same as a
 //!    Stop: from the top speed of 0.48 m/s the reference is at zero after 0.6 s, and the lean
 //!    it costs stays near 6°); the legs ramp into the fold if the latch came mid-fold
 //!    ([`StopConfig::fold_rate_rad_s`]).

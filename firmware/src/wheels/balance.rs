@@ -17,8 +17,12 @@
 //! ```
 //!
 //! The gains `K` of `τ = −K x` solve the discrete LQR problem for this model at the control
-//! rate, with Bryson weights (p 0.2 m, θ 0.1 rad, v 0.5 m/s, θ̇ 1 rad/s, τ 30 N·m). The
-//! design lives in `firmware/tests/balance_lqr.rs` (host, `nalgebra`): it recomputes `K` from
+//! rate, with Bryson weights (p 0.15 m, θ 0.1 rad, v 0.3 m/s, θ̇ 1 rad/s, τ 30 N·m). These
+//! leave the delay margin of a real CAN loop: with the stiffer p 0.1 m and v 0.2 m/s the
+//! simulated robot at rest fell into a 15.5 Hz limit cycle at full torque with 12 ms of loop
+//! latency (a mode of the body the pendulum model does not have; `sim-host/tests/latency.rs`);
+//! the softer p 0.2 m and v 0.5 m/s brake too late for the E-stop's 1 s to rest.
+//! The design lives in `firmware/tests/balance_lqr.rs` (host, `nalgebra`): it recomputes `K` from
 //! [`BalanceModel::ROBOT`], fails if [`BalanceGains::ROBOT`] is stale and prints the new gains,
 //! and checks the closed loop on the linear model.
 //!
@@ -72,10 +76,10 @@ pub struct BalanceGains {
 impl BalanceGains {
     /// LQR gains for [`BalanceModel::ROBOT`] at 250 Hz (see the module docs).
     pub const ROBOT: Self = Self {
-        position_nm_per_m: -258.5094,
-        pitch_nm_per_rad: -610.3082,
-        velocity_nm_per_m_s: -278.9801,
-        pitch_rate_nm_per_rad_s: -130.7839,
+        position_nm_per_m: -176.7789,
+        pitch_nm_per_rad: -504.7005,
+        velocity_nm_per_m_s: -205.0894,
+        pitch_rate_nm_per_rad_s: -102.2190,
     };
 
     /// As an array `[p, θ, v, θ̇]`.

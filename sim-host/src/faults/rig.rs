@@ -282,7 +282,8 @@ impl Rig {
     /// from tick 0) on the same bus, as when the simulator process is restarted.
     pub fn restart_simulator(&mut self) -> Result<(), SessionError> {
         // (The firmware keeps running: its counters go on.)
-        self.sim = Simulator::new(&self.model, RIG_HZ, StartPose::standing(), Plant::default())?;
+        let plant = *self.sim.plant();
+        self.sim = Simulator::new(&self.model, RIG_HZ, StartPose::standing(), plant)?;
         Ok(())
     }
 
@@ -296,9 +297,11 @@ impl Rig {
         Ok(self.tool.send(frame)?)
     }
 
-    /// Changes the faults on the simulator's connection from now on.
+    /// Changes the faults on the simulator's connection from now on (the plant's transport
+    /// delay stays).
     pub fn set_faults(&mut self, faults: &Faults) {
-        self.sim_bus.set_faults(faults);
+        self.sim_bus
+            .set_faults(&self.sim.plant().link_faults(faults));
     }
 
     /// Every cycle so far.

@@ -55,6 +55,7 @@ pub struct Simulator {
     now_us: u64,
     /// The simulator's clock as a bus node: it sends SYNC in the controller's session.
     clock: NodeLink,
+    plant: Plant,
 }
 
 impl Simulator {
@@ -100,7 +101,13 @@ impl Simulator {
             cycle: 0,
             now_us: 0,
             clock: NodeLink::new(key),
+            plant,
         })
+    }
+
+    /// The parts it emulates.
+    pub fn plant(&self) -> &Plant {
+        &self.plant
     }
 
     /// The physics (ground truth).
