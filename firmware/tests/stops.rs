@@ -38,10 +38,11 @@ fn no_request_but_stop_acts_after_start_or_a_release_until_a_stop_arrives() {
     bench.send(command(TeleopMode::WheelForward));
     bench.tick();
     assert!(matches!(bench.state(), State::Folding(_)));
-    // An E-stop released: the robot holds, interlocked again.
+    // An E-stop released (once its stop is over): the robot holds, interlocked again.
     bench.send(estop(EStopAction::Latch));
     bench.tick();
     bench.send(estop(EStopAction::Clear));
+    bench.run(ms(SS1_DEADLINE_MS));
     let output = bench.tick();
     assert_eq!(bench.state(), State::Hold);
     assert!(output.status.faults.contains(FaultFlags::AWAITING_STOP));
@@ -279,4 +280,44 @@ fn a_release_resets_no_frozen_sync() {
     bench.run(ms(SS1_DEADLINE_MS));
     assert_eq!(bench.state(), State::EStop);
     assert_release_keeps_the_fault(&mut bench, FaultFlags::SYNC_LOST);
+}
+
+#[test]
+fn a_release_during_the_controlled_stop_waits_for_its_end() {
+    let mut bench = Bench::ready();
+    bench.send(command(TeleopMode::WheelForward));
+    bench.run(ms(6_000));
+    assert!(matches!(bench.state(), State::Wheels(_)));
+    bench.send(estop(EStopAction::Latch));
+    bench.run(50);
+    // Released mid-stop: the stop goes on, the robot stays latched.
+    bench.send(estop(EStopAction::Clear));
+    let mut released_at = None;
+    let mut off_seen = false;
+    for n in 0..ms(SS1_DEADLINE_MS) {
+        let output = bench.tick();
+        off_seen |= torque_free(&output);
+        if bench.state() != State::EStop {
+            released_at = Some(n);
+            break;
+        }
+        assert!(
+            !off_seen || torque_free(&output),
+            "tick {n}: a drive came back on"
+        );
+    }
+    let released_at = released_at.expect("released once the stop ended");
+    assert!(off_seen, "released before the stop was torque-free");
+    assert!(released_at > 10, "released at once: {released_at}");
+    assert_eq!(bench.state(), State::Hold);
+    // A new latch while a release waits cancels it.
+    let mut bench = Bench::ready();
+    bench.send(command(TeleopMode::WheelForward));
+    bench.run(ms(6_000));
+    bench.send(estop(EStopAction::Latch));
+    bench.run(50);
+    bench.send(estop(EStopAction::Clear));
+    bench.send(estop(EStopAction::Latch));
+    bench.run(ms(SS1_DEADLINE_MS) + 10);
+    assert_eq!(bench.state(), State::EStop, "the later latch holds");
 }

@@ -67,6 +67,9 @@ pub struct Controller {
     runaway: Runaway,
     /// What the runaway detector found, reported until the fault is reset.
     wheel_fault: FaultFlags,
+    /// An authentic release heard while the controlled stop still ran: it takes effect when
+    /// the stop is over (see [`Controller::release`]).
+    release_pending: bool,
     /// The fold under way (`Folding`; `None` otherwise).
     transfer: Option<Transfer>,
     /// Whether that fold has ended.
@@ -112,6 +115,7 @@ impl Controller {
             stop: None,
             runaway: Runaway::new(&config.runaway, rate),
             wheel_fault: FaultFlags::EMPTY,
+            release_pending: false,
             transfer: None,
             transfer_done: false,
             wheels_since: None,
@@ -184,10 +188,7 @@ impl Controller {
         match message {
             AnyMessage::EStop(estop) => match estop.action {
                 EStopAction::Latch => self.latch(now),
-                EStopAction::Clear => {
-                    self.apply(Event::EStopClear);
-                    self.fault_on_held_cause();
-                }
+                EStopAction::Clear => self.release(),
             },
             AnyMessage::LegFeedback(leg, feedback) => self.sensors.record_leg(now, *leg, feedback),
             AnyMessage::WheelFeedback(feedback) => self.sensors.record_wheels(now, feedback),
@@ -237,7 +238,10 @@ impl Controller {
         let mut legs_enabled = self.armed;
         let state = self.state;
         match state {
-            State::EStop => legs_enabled &= self.run_stop(now),
+            State::EStop => {
+                legs_enabled &= self.run_stop(now);
+                self.release_when_stopped();
+            }
             State::Fault if self.stop.is_some() => legs_enabled &= self.run_stop(now),
             State::Hold | State::Fault => {}
             State::Standing(motion) if self.rolling() => {
@@ -372,6 +376,7 @@ impl Controller {
         }
         if next != State::EStop {
             self.stop = None;
+            self.release_pending = false;
         }
         if self.state == State::Fault {
             self.wheel_fault = FaultFlags::EMPTY;

@@ -26,7 +26,7 @@
 //! | event         | result                                                                     |
 //! |---------------|----------------------------------------------------------------------------|
 //! | `EStopLatch`  | `EStop` from any state                                                     |
-//! | `EStopClear`  | `EStop` → `Hold` (the controller then raises `Fault` if a drive's fault or a frozen SYNC remains); no effect elsewhere |
+//! | `EStopClear`  | `EStop` → `Hold`; no effect elsewhere. The controller applies a release once its controlled stop has ended, and then raises `Fault` if a drive's fault or a frozen SYNC remains |
 //! | `Fault`       | `Fault` from any state but `EStop` (an E-stop outranks a fault)            |
 //! | `Reset`       | `Fault` → `Hold` (sent when the operator asks to stop and no cause remains); no effect elsewhere |
 //!

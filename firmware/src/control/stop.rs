@@ -289,6 +289,8 @@ pub struct Stop {
     /// Whether the wheels hold still instead of balancing.
     holds_wheels: bool,
     phase: Phase,
+    /// Whether a tick of the stop has commanded every drive torque-free.
+    cut: bool,
 }
 
 impl Stop {
@@ -345,6 +347,7 @@ impl Stop {
             kickstand_needed,
             holds_wheels: carrier == Carrier::Blocked,
             phase,
+            cut: false,
         }
     }
 
@@ -394,15 +397,26 @@ impl Stop {
                 )
             }
             Phase::Settle(since, pose) => {
-                let settled = now.since(since) >= self.rate.ticks_from_ms(self.config.settle_ms);
-                (StopCommand::Servo(pose), settled.then_some(Phase::Off))
+                // Off from the tick the settle ends: the phase is `Off` only once the torque is.
+                if now.since(since) >= self.rate.ticks_from_ms(self.config.settle_ms) {
+                    (StopCommand::Off, Some(Phase::Off))
+                } else {
+                    (StopCommand::Servo(pose), None)
+                }
             }
             Phase::Off => (StopCommand::Off, None),
         };
         if let Some(next) = next {
             self.phase = next;
         }
+        self.cut |= command == StopCommand::Off;
         command
+    }
+
+    /// Whether a tick of the stop has commanded every drive torque-free (it is then over: a
+    /// stop of category 1 ends torque-free).
+    pub fn cut(&self) -> bool {
+        self.cut
     }
 
     /// Whether the kickstand must start now to be reached and settled before the deadline

@@ -79,7 +79,7 @@ impl BalanceGains {
         position_nm_per_m: -176.7789,
         pitch_nm_per_rad: -504.7005,
         velocity_nm_per_m_s: -205.0894,
-        pitch_rate_nm_per_rad_s: -102.2190,
+        pitch_rate_nm_per_rad_s: -102.219,
     };
 
     /// As an array `[p, θ, v, θ̇]`.

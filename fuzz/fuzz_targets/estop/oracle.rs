@@ -8,6 +8,8 @@
 //!   only on the first delivery of a release sealed under the key in the present epoch whose
 //!   token is the one the node publishes at that moment. A replayed frame, a release of
 //!   another epoch or key, one with a wrong or earlier token, a corrupted one never releases.
+//!   A release heard while the controlled stop still runs takes effect on the stop's first
+//!   torque-free tick, unless a later latch cancels it.
 //! - **No motion command obeyed while latched**: the state is `EStop` and the status says so
 //!   at every tick, and the drive commands (legs enabled, leg targets, wheel torques) are
 //!   exactly those of a twin node that heard every frame but the operator's (commands,
@@ -72,6 +74,9 @@ struct Latched {
     polls: u32,
     /// Whether a tick since was torque-free (then every later one must be).
     off: bool,
+    /// Whether a fresh authenticated release was delivered while the stop still ran: the node
+    /// must take it on the first torque-free tick, and not before.
+    release_heard: bool,
 }
 
 /// The contract's model of the node under test.
@@ -155,6 +160,11 @@ impl Oracle {
         }
         match (self.latched.is_some(), node.estop_latched()) {
             (true, false) => {
+                let stopped = self.latched.is_some_and(|latched| latched.off);
+                assert!(
+                    stopped,
+                    "released by frame {id:03X} while the controlled stop still ran"
+                );
                 assert!(
                     legit_release,
                     "released by {origin:?} frame {id:03X} {data:02X?} ({message:?}), which is \
@@ -175,8 +185,19 @@ impl Oracle {
                     at: now,
                     polls: 0,
                     off: false,
+                    release_heard: false,
                 });
                 self.twin = Some(node.clone());
+            }
+            (true, true) => {
+                if let Some(latched) = self.latched.as_mut().filter(|_| result.is_ok()) {
+                    if legit_release {
+                        latched.release_heard = true;
+                    } else if latch {
+                        // A later latch cancels a release that waits.
+                        latched.release_heard = false;
+                    }
+                }
             }
             _ => {}
         }
@@ -204,8 +225,20 @@ impl Oracle {
                 now.0
             );
         }
-        if let Some(latched) = self.latched.as_mut() {
+        let released = self.latched.is_some() && !node.estop_latched();
+        if let Some(latched) = self.latched.filter(|_| released) {
+            check_deferred_release(now, &latched, &output);
+            self.latched = None;
+            self.twin = None;
+            self.awaiting_stop = Some(None);
+        } else if let Some(latched) = self.latched.as_mut() {
+            let waited = latched.release_heard && latched.off;
             check_latched(node, now, latched, self.cut_ticks, &output, &frames);
+            assert!(
+                !waited,
+                "tick {}: a release heard during the stop still waits after its end",
+                now.0
+            );
         } else if let Some(held) = self.awaiting_stop.as_mut() {
             check_interlocked(node, now, held, &output);
         }
@@ -225,8 +258,10 @@ impl Oracle {
             "the latch did not survive the restart"
         );
         if let Some(latched) = self.latched.as_mut() {
-            // Restored unarmed: nothing to bring to rest, torque-free at once.
+            // Restored unarmed: nothing to bring to rest, torque-free at once; a release that
+            // waited is forgotten with the rest of the controller's state.
             latched.off = true;
+            latched.release_heard = false;
             self.twin = Some(node.clone());
         }
     }
@@ -294,6 +329,20 @@ fn check_latched(
         }
     }
     latched.off |= free;
+}
+
+/// Left the latch on a tick, not on a frame: only a release heard while the stop ran, and only
+/// once the stop is torque-free.
+fn check_deferred_release(now: Tick, latched: &Latched, output: &Output) {
+    let t = now.0;
+    assert!(
+        latched.release_heard,
+        "tick {t}: left the latch without a fresh authenticated release"
+    );
+    assert!(
+        torque_free(output),
+        "tick {t}: released before the stop was torque-free: {output:?}"
+    );
 }
 
 /// Awaiting STOP after a start, restart or release: nothing moves.

@@ -14,6 +14,8 @@ impl Controller {
     /// [`crate::control::stop`]). A latch while latched changes nothing.
     pub(super) fn latch(&mut self, now: Tick) {
         if self.state == State::EStop {
+            // A new latch outranks a release still waiting for the stop to end.
+            self.release_pending = false;
             return;
         }
         if self.state == State::Fault && self.stop.is_some_and(|stop| !stop.off()) {
@@ -32,6 +34,31 @@ impl Controller {
         let stop = Stop::new(config, rate, now, self.legs_rad, self.fold_rad, carrier);
         self.stop = Some(stop);
         self.apply(Event::EStopLatch);
+    }
+
+    /// An authentic release (the node has checked its token): `Hold` — or `Fault` while a drive
+    /// fault or a frozen SYNC remains — once the controlled stop is over. A release heard while
+    /// the stop still brakes or sets the robot down waits for its end: in `Hold` nothing
+    /// balances, and a robot released mid-brake tipped 19° over.
+    pub(super) fn release(&mut self) {
+        if self.state != State::EStop {
+            return;
+        }
+        if !self.stop.is_none_or(|stop| stop.cut()) {
+            self.release_pending = true;
+            return;
+        }
+        self.apply(Event::EStopClear);
+        self.fault_on_held_cause();
+    }
+
+    /// Takes a waiting release once the stop is over (call after [`Controller::run_stop`]:
+    /// the tick the stop ends is torque-free, as a stop of category 1 ends, before anything is
+    /// re-enabled).
+    pub(super) fn release_when_stopped(&mut self) {
+        if self.release_pending && self.stop.is_none_or(|stop| stop.cut()) {
+            self.release();
+        }
     }
 
     /// Runs this tick of the controlled stop: whether the legs stay enabled.
