@@ -12,8 +12,10 @@ use protocol::{ControllerMode, ControllerStatus, EStop, NodeId, ReleaseToken};
 
 /// How often a release is sent again until the controller reports it left its E-stop, ms.
 pub const RELEASE_REPEAT_MS: u64 = 50;
-/// How long a release is tried before it is given up (the controller kept its E-stop), ms.
-pub const RELEASE_TIMEOUT_MS: u64 = 1_000;
+/// How long a release is tried before it is given up (the controller kept its E-stop), ms:
+/// the controller takes a release once its controlled stop is over, which may be up to the
+/// SS1 deadline (2 s) after the latch, and the status that confirms it crosses the bus after.
+pub const RELEASE_TIMEOUT_MS: u64 = 2_500;
 
 /// How a release the operator asked for ended, as the controller reported it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
