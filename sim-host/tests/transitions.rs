@@ -109,13 +109,13 @@ fn w_s_and_a_from_standing_fold_in_place() {
 #[test]
 fn the_fold_right_after_a_trot_happens_in_place() {
     for (what, trot, tilt_deg) in [
-        ("fold right after L", TeleopMode::TrotForward, 10.5),
+        ("fold right after L", TeleopMode::TrotForward, 11.0),
         ("fold right after K", TeleopMode::TrotBackward, 14.0),
     ] {
         let before = [(0.0, TeleopMode::Stop), (0.1, trot)];
         assert_in_place(
             &transition(what, &before, TeleopMode::Fold, 4.0),
-            0.05,
+            0.06,
             tilt_deg,
         );
     }

@@ -92,8 +92,9 @@ pub struct StopConfig {
     /// How long the kickstand pose is held, balancing, before the torque goes, ms.
     pub settle_ms: u32,
     /// How long before [`SS1_DEADLINE_MS`] the controller commands torque off, ms: the
-    /// command has to reach the drives by the deadline through the bus's transport delay (a
-    /// cycle or two), whatever the drives' own timers do.
+    /// command has to reach the drives by the deadline through the bus's transport delay (up
+    /// to two 4 ms cycles), whatever the drives' own timers do. Every millisecond of it is
+    /// taken from the sit-down, whose torso descent grows as the ramp shortens.
     pub cut_margin_ms: u32,
     /// Outward hip abduction of the front legs midway through the kickstand from the wheels,
     /// rad (none at either end). Their feet pass under the hips on the way to the stops, 9 cm
@@ -118,7 +119,7 @@ impl StopConfig {
         kickstand_rate_rad_s: 3.0,
         rest_speed_m_s: 0.02,
         settle_ms: 100,
-        cut_margin_ms: 20,
+        cut_margin_ms: 12,
         kickstand_spread_rad: deg_to_rad(34.0),
         wheel_hold_nm_per_rad_s: 10.0,
         kickstand_front: LegJoints {

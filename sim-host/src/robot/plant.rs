@@ -65,15 +65,14 @@ impl Plant {
 }
 
 impl Default for Plant {
-    /// The tested default: the drives measure with real encoders ([`DriveSensing::REAL`]).
-    /// Still ideal drive ratings and no transport delay: on rated drives a trot after S
-    /// presses a hip 1° past its range, and with a cycle of delay the drives hear an E-stop
-    /// latch a cycle late (their own cut then comes after the deadline; the wheel command
-    /// has no torque-off to send earlier).
+    /// The tested default: rated drives ([`DriveRatings::RATED`]) that measure with real
+    /// encoders ([`DriveSensing::REAL`]). No transport delay yet: with a cycle of delay the
+    /// drives hear an E-stop latch a cycle late (their own cut then comes after the deadline;
+    /// the wheel command has no torque-off to send earlier).
     fn default() -> Self {
         Self {
             imu_noise: ImuNoise::default(),
-            drives: DriveRatings::IDEAL,
+            drives: DriveRatings::RATED,
             sensing: DriveSensing::REAL,
             transport_delay_cycles: 0,
             variation: Variation::NOMINAL,

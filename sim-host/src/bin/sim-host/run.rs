@@ -118,9 +118,8 @@ pub(crate) struct RunArgs {
     pub(crate) seed: u64,
     /// What the drives can deliver: `rated` (a quasi-direct-drive leg actuator, 33.5 N·m peak
     /// with its torque-speed line and thermal foldback; 30 N·m hub motors) or `ideal` (the
-    /// report's unlimited leg servos, flat 30 N·m wheels). Default: `ideal`, until the
-    /// controller copes with rated drives.
-    #[arg(long, value_enum, default_value_t = DrivesArg::Ideal)]
+    /// report's unlimited leg servos, flat 30 N·m wheels, for debugging).
+    #[arg(long, value_enum, default_value_t = DrivesArg::Rated)]
     pub(crate) drives: DrivesArg,
     /// How the drives measure their joints: `real` (14-bit encoders, velocity from count
     /// differences, effort within ±5 % gain error; see docs/simulator.md) or `ideal` (MuJoCo's
