@@ -4,6 +4,14 @@
 use proptest::prelude::*;
 use protocol::*;
 
+pub mod bus;
+pub mod checker;
+pub mod clock;
+pub mod frames;
+pub mod protected;
+pub mod recorded;
+pub mod search;
+
 macro_rules! raw_strategy {
     ($fn:ident, $ty:ident, $raw:ty) => {
         pub fn $fn() -> impl Strategy<Value = $ty> {
