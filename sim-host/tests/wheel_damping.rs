@@ -111,7 +111,10 @@ fn fold_with(damping: f64) -> Figures {
 fn the_fold_catches_the_robot_whatever_the_wheel_damping() {
     let all: Vec<Figures> = [0.02, 0.1, 0.5, 2.0].map(fold_with).into_iter().collect();
     for f in &all {
-        println!("MEASURED {f:?}");
+        println!(
+            "MEASURED wheel damping {} N·m·s/rad: {f:?}",
+            f.damping_nm_s_rad
+        );
     }
     for f in all {
         assert!(!f.fell, "{f:?}");
