@@ -1,9 +1,10 @@
 //! The control step and what keeps it safe: the [`controller`] runs the [`fsm`]'s mode, with
-//! the [`safety`] watchdogs and clamps around it, the [`sensors`] it last heard, the operator's
+//! the [`safety`] watchdogs and clamps around it, the [`sensors`] it last heard (attitude from the IMU by the [`estimator`]), the operator's
 //! [`teleop`] requests and the E-stop's controlled [`stop`]; its [`output`] is the commands and
 //! the telemetry.
 
 pub mod controller;
+pub mod estimator;
 pub mod fsm;
 pub mod output;
 pub mod safety;
