@@ -38,9 +38,8 @@ fn feedback(joints_rad: &Joints<f32>) -> Vec<AnyMessage> {
         effort: [Torque::saturating_from_si(1.0); 2],
     }));
     messages.push(AnyMessage::Imu(Imu {
-        orientation: Imu::orientation_of([0.9999, 0.0, 0.0123, 0.0]),
         angular_rate: [0.0, 0.05, 0.0].map(AngularRate::saturating_from_si),
-        acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
+        acceleration: [-0.24, 0.0, 9.8].map(Acceleration::saturating_from_si),
     }));
     messages
 }

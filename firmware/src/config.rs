@@ -1,5 +1,6 @@
 //! Every tunable of the controller in one value, with the report's numbers as defaults.
 
+use crate::control::estimator::EstimatorConfig;
 use crate::control::stop::StopConfig;
 use crate::legs::gait::TrotParams;
 use crate::legs::kinematics::LegGeometry;
@@ -73,6 +74,8 @@ pub struct Config {
     pub link_recover_permille: u32,
     /// Pitch or roll beyond this is a fall: fault, rad.
     pub tilt_limit_rad: f32,
+    /// The attitude filter on the IMU's gyro and accelerometer.
+    pub attitude: EstimatorConfig,
     /// The E-stop's controlled stop (within [`crate::control::safety::SS1_DEADLINE_MS`]),
     /// also run when the wheels stall or run away.
     pub stop: StopConfig,
@@ -119,6 +122,7 @@ impl Config {
         link_degrade_permille: 100,
         link_recover_permille: 30,
         tilt_limit_rad: crate::math::deg_to_rad(45.0),
+        attitude: EstimatorConfig::ROBOT,
         stop: StopConfig::ROBOT,
         runaway: RunawayConfig::ROBOT,
     };

@@ -193,13 +193,12 @@ fn any_message() -> impl Strategy<Value = AnyMessage> {
             )
         }),
         (
-            prop::array::uniform4(-1.0f32..1.0),
-            prop::array::uniform3(-30.0f32..30.0)
+            prop::array::uniform3(-30.0f32..30.0),
+            prop::array::uniform3(-20.0f32..20.0)
         )
-            .prop_map(|(q, w)| AnyMessage::Imu(Imu {
-                orientation: Imu::orientation_of(q),
+            .prop_map(|(w, a)| AnyMessage::Imu(Imu {
                 angular_rate: w.map(AngularRate::saturating_from_si),
-                acceleration: [Acceleration::saturating_from_si(0.0); 3],
+                acceleration: a.map(Acceleration::saturating_from_si),
             })),
         prop::array::uniform2(-300.0f32..300.0).prop_map(|v| AnyMessage::WheelFeedback(
             WheelFeedback {

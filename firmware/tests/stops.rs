@@ -180,7 +180,8 @@ fn a_fall_is_a_fault() {
     bench.send(command(TeleopMode::WheelForward));
     bench.run(100);
     bench.pitch_rad = 1.0;
-    bench.run(2);
+    // 45° at 10 rad/s: 79 ms, and the tick after.
+    bench.run(ms(84));
     assert_eq!(bench.state(), State::Fault);
     assert!(bench.tick().status.faults.contains(FaultFlags::TILT_LIMIT));
 }

@@ -29,15 +29,13 @@ wire_scalar!(
     Torque(i16) = I16, exp10 -2, unit "N.m", raw i16::MIN, i16::MAX
 );
 wire_scalar!(
-    /// Unit-quaternion component. 1e-4, `i16`, accepted −10000…10000 (±1).
-    QuatComponent(i16) = I16, exp10 -4, unit "", raw -10_000, 10_000
-);
-wire_scalar!(
-    /// Angular rate from the gyro. 1e-3 rad/s, `i16` (±32.767 rad/s).
+    /// Angular rate from the gyro. 1e-3 rad/s, `i16` (±32.767 rad/s: holds the IMU chip's
+    /// ±1000 °/s, and a step is a quarter of its noise).
     AngularRate(i16) = I16, exp10 -3, unit "rad/s", raw i16::MIN, i16::MAX
 );
 wire_scalar!(
-    /// Specific force from the accelerometer. 1e-2 m/s², `i16` (±327.67 m/s², ±33 g).
+    /// Specific force from the accelerometer. 1e-2 m/s², `i16` (±327.67 m/s², ±33 g: holds the
+    /// IMU chip's ±6 g, and a step is under half its noise).
     Acceleration(i16) = I16, exp10 -2, unit "m/s^2", raw i16::MIN, i16::MAX
 );
 wire_scalar!(

@@ -18,7 +18,7 @@ use protocol::{
 use sim_host::clock::lockstep::{self, LockstepOptions};
 use sim_host::output::recorder::Recorder;
 use sim_host::robot::drive_core::{Authority, SS1_TIMER_US};
-use sim_host::robot::imu::ImuNoise;
+use sim_host::robot::imu::{ImuModel, ImuNoise};
 use sim_host::robot::model::DEFAULT_MODEL;
 use sim_host::robot::plant::Plant;
 use sim_host::session::simulator::{Simulator, StartPose};
@@ -415,19 +415,50 @@ fn an_e_stop_frame_lets_the_drives_obey_for_the_ss1_timer_then_stops_them_until_
     }
 }
 
+/// Gyro x over the second half of `cycles` cycles of a robot standing still on `plant`: mean
+/// and standard deviation.
+fn still_gyro_x(plant: Plant, cycles: u64) -> ((f32, f32), Simulator) {
+    let mut sim =
+        Simulator::new(Path::new(DEFAULT_MODEL), HZ, StartPose::standing(), plant).unwrap();
+    let bus_all = InprocBus::new();
+    let mut sim_bus = bus_all.endpoint();
+    let ctl = Rc::new(RefCell::new(TestController::new(bus_all.endpoint())));
+    run(&mut sim, &mut sim_bus, &ctl, cycles, |_| {});
+    let samples: Vec<f32> = ctl.borrow().imu_gyro[cycles as usize / 2..]
+        .iter()
+        .map(|s| s[0])
+        .collect();
+    let n = samples.len() as f32;
+    let mean = samples.iter().sum::<f32>() / n;
+    let var = samples.iter().map(|s| (s - mean).powi(2)).sum::<f32>() / n;
+    ((mean, var.sqrt()), sim)
+}
+
 #[test]
-fn the_imu_is_ideal_by_default_and_noisy_when_asked() {
-    let (mut sim, mut bus, ctl) = setup();
-    run(&mut sim, &mut bus, &ctl, 250, |_| {});
-    let still: Vec<_> = ctl.borrow().imu_gyro[125..].to_vec();
-    let spread = |samples: &[[f32; 3]]| {
-        let n = samples.len() as f32;
-        let mean = samples.iter().map(|s| s[0]).sum::<f32>() / n;
-        let var = samples.iter().map(|s| (s[0] - mean).powi(2)).sum::<f32>() / n;
-        (mean, var.sqrt())
+fn the_imu_is_a_bmi088_by_default_ideal_or_noisier_when_asked() {
+    // The chip: its turn-on bias and its noise over the filter's bandwidth (0.014 °/s/√Hz
+    // over ~255 Hz: 3.9e-3 rad/s RMS).
+    let ((mean, std), sim) = still_gyro_x(Plant::default(), 500);
+    let (bias, _) = sim.hardware().imu().chip().unwrap().bias();
+    println!(
+        "chip: gyro x mean {mean:.4} (bias {:.4}), std {std:.4}",
+        bias[0]
+    );
+    assert!(
+        (f64::from(mean) - bias[0]).abs() < 0.002,
+        "mean {mean} vs bias {bias:?}"
+    );
+    assert!((0.003..0.006).contains(&std), "std {std}");
+
+    let ideal = Plant {
+        imu: ImuModel::Ideal,
+        ..Plant::default()
     };
-    let (_, quiet) = spread(&still);
-    assert!(quiet < 0.01, "a still robot's ideal gyro: std {quiet}");
+    let ((mean, quiet), _) = still_gyro_x(ideal, 250);
+    assert!(
+        mean.abs() < 0.002 && quiet < 0.002,
+        "a still robot's ideal gyro: {mean} ± {quiet}"
+    );
 
     let noise = ImuNoise {
         gyro_std_rad_s: 0.05,
@@ -435,18 +466,12 @@ fn the_imu_is_ideal_by_default_and_noisy_when_asked() {
         seed: 7,
         ..ImuNoise::default()
     };
-    let plant = Plant {
+    let noisy = Plant {
+        imu: ImuModel::Ideal,
         imu_noise: noise,
         ..Plant::default()
     };
-    let mut sim =
-        Simulator::new(Path::new(DEFAULT_MODEL), HZ, StartPose::standing(), plant).unwrap();
-    let bus_all = InprocBus::new();
-    let mut sim_bus = bus_all.endpoint();
-    let ctl = Rc::new(RefCell::new(TestController::new(bus_all.endpoint())));
-    run(&mut sim, &mut sim_bus, &ctl, 250, |_| {});
-    let noisy: Vec<_> = ctl.borrow().imu_gyro[125..].to_vec();
-    let (mean, std) = spread(&noisy);
+    let ((mean, std), _) = still_gyro_x(noisy, 250);
     assert!((mean - 0.2).abs() < 0.02, "bias: mean {mean}");
     assert!((std - 0.05).abs() < 0.015, "noise: std {std}");
 }

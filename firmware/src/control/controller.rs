@@ -2,6 +2,8 @@
 //! caller owns the clock and the bus and hands in the tick.
 //!
 //! Each tick ([`Controller::step`]):
+//! 0. the IMU's sample of this tick goes through the attitude
+//!    [`estimator`](crate::control::estimator), told what carries the robot;
 //! 1. the supervisor checks the watchdogs and the tilt and raises faults;
 //! 2. a running transition that has arrived fires `PoseReached`;
 //! 3. the state picks the legs' goal pose (hold, stance, trot, fold, or the E-stop's controlled
@@ -9,6 +11,7 @@
 //! 4. the legs' targets move toward the goal with the report's smoothing;
 //! 5. every output is clamped to the joint and torque limits and made finite.
 
+mod carrier;
 mod folding;
 mod status;
 mod stopping;
@@ -16,6 +19,7 @@ mod stopping;
 use protocol::{AnyMessage, DriveFlags, EStopAction, FaultFlags, Joints, Leg, PerDrive};
 
 use crate::config::Config;
+use crate::control::estimator::AttitudeEstimator;
 use crate::control::fsm::{Direction, Event, LegMotion, State, WheelMotion};
 pub use crate::control::output::{ConfigError, Output, Status};
 use crate::control::safety::{clamp_leg_targets, clamp_wheel_torques};
@@ -76,14 +80,17 @@ pub struct Controller {
     transfer_done: bool,
     /// When the balance law took the wheels (`None` while it does not drive them).
     wheels_since: Option<Tick>,
-    /// Where the measured legs put the feet, once computed this tick (see
-    /// [`crate::legs::support`]).
+    /// Where the measured legs put the feet, computed at most once a tick (see
+    /// [`crate::legs::support`] and [`Controller::wheels_may_drive`]).
     leg_stance: Option<LegStance>,
     /// The feet's mean position forward of the hips when a fold from the legs began, m
     /// (`None` otherwise).
     fold_origin_x_m: Option<f32>,
     /// When the running fold's legs were tucked (`None` before, or with no fold).
     fold_done_at: Option<Tick>,
+    /// Ground speed of the wheels last tick, m/s (`None` off the wheels): its change is the
+    /// acceleration the attitude estimator takes out of the accelerometer's reading.
+    last_ground_m_s: Option<f32>,
 }
 
 impl Controller {
@@ -97,6 +104,7 @@ impl Controller {
             sensors: Sensors::new(
                 rate.ticks_from_ms(config.feedback_timeout_ms),
                 rate.ticks_from_ms(config.imu_timeout_ms),
+                AttitudeEstimator::new(config.attitude, rate),
             ),
             teleop: Teleop::new(rate.ticks_from_ms(config.teleop_timeout_ms)),
             trot,
@@ -122,6 +130,7 @@ impl Controller {
             leg_stance: None,
             fold_origin_x_m: None,
             fold_done_at: None,
+            last_ground_m_s: None,
         })
     }
 
@@ -227,6 +236,8 @@ impl Controller {
     /// Runs one control tick at `now`.
     pub fn step(&mut self, now: Tick) -> Output {
         self.leg_stance = None;
+        let motion = self.motion();
+        self.sensors.estimate(motion);
         self.supervise(now);
         if !self.armed {
             self.follow_measured();
@@ -312,8 +323,8 @@ impl Controller {
             self.armed = true;
             self.follow_measured();
         }
-        let imu_stale = self.sensors.imu_stale(now);
-        self.tilted = !imu_stale && self.sensors.attitude.tilt_rad() > self.config.tilt_limit_rad;
+        let known = self.sensors.attitude_known(now);
+        self.tilted = known && self.sensors.attitude.tilt_rad() > self.config.tilt_limit_rad;
         if self.teleop.just_lost(now) {
             self.apply(Event::TeleopLost);
         }
@@ -323,7 +334,7 @@ impl Controller {
         }
         let moving = !matches!(self.state, State::Hold);
         if self.sensors.drives_stale(now)
-            || (imu_stale && self.state.balancing())
+            || (!known && self.state.balancing() && self.wheels_may_drive())
             || (self.tilted && moving)
         {
             self.apply(Event::Fault);
@@ -345,15 +356,6 @@ impl Controller {
         let r = self.config.balance.wheel_radius_m;
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
         r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s)
-    }
-
-    /// Whether the robot still rolls on its wheels (ground speed above 5 cm/s, or turning) while
-    /// they carry it.
-    fn rolling(&mut self) -> bool {
-        let r = self.config.balance.wheel_radius_m;
-        let speed_m_s = r * self.sensors.mean_wheel_rate_rad_s();
-        let turn_m_s = r * self.sensors.differential_wheel_rate_rad_s();
-        self.wheels_may_drive() && (speed_m_s.abs() > 0.05 || turn_m_s.abs() > 0.05)
     }
 
     fn apply(&mut self, event: Event) {
@@ -435,7 +437,7 @@ impl Controller {
     }
 
     fn wheel_law(&mut self, now: Tick, dt_s: f32) -> [f32; 2] {
-        if self.sensors.imu_stale(now) {
+        if !self.sensors.attitude_known(now) {
             return [0.0; 2];
         }
         let config = &self.config;

@@ -46,7 +46,8 @@
 //!
 //! # Start-up
 //!
-//! The first sample that feels about 1 g sets `v` from the accelerometer (initial alignment),
+//! The first sample that feels about 1 g and shows no fast turn sets `v` from the
+//! accelerometer (initial alignment),
 //! and for [`EstimatorConfig::start_ms`] the filter runs with the fast
 //! [`EstimatorConfig::kp_start_per_s`] and no bias integral, so that it converges from the
 //! accelerometer within about a second, before or while the controller arms. The first time
@@ -251,15 +252,7 @@ impl AttitudeEstimator {
         let ticks = now.since(self.last);
         let up = match self.up {
             Some(up) if ticks <= self.max_gap_ticks => up,
-            _ => {
-                // (Re)start: up is where the accelerometer points, if it feels about 1 g.
-                let norm = sqrt(dot(accel_m_s2, accel_m_s2));
-                if !self.near_g(norm) {
-                    return false;
-                }
-                self.start(now, scale(accel_m_s2, 1.0 / norm), gyro_rad_s);
-                return true;
-            }
+            _ => return self.try_start(now, gyro_rad_s, accel_m_s2),
         };
         if ticks == 0 {
             return false;
@@ -363,6 +356,17 @@ impl AttitudeEstimator {
             let k = (dt_s / self.config.rest_s).min(1.0);
             self.rest_m_s2 += k * (norm - self.rest_m_s2);
         }
+    }
+
+    /// (Re)start: up is where the accelerometer points, from a sample that feels about 1 g and
+    /// shows no fast turn (not one of a fall).
+    fn try_start(&mut self, now: Tick, gyro_rad_s: [f32; 3], accel_m_s2: [f32; 3]) -> bool {
+        let norm = sqrt(dot(accel_m_s2, accel_m_s2));
+        if !(self.near_g(norm) && self.turn_weight(gyro_rad_s) > 0.0) {
+            return false;
+        }
+        self.start(now, scale(accel_m_s2, 1.0 / norm), gyro_rad_s);
+        true
     }
 
     fn start(&mut self, now: Tick, up: [f32; 3], gyro_rad_s: [f32; 3]) {

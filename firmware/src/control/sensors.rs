@@ -1,8 +1,10 @@
 //! The latest feedback from the drives and the IMU, in SI units, with a watchdog per source.
+//! The IMU sends rate and specific force; the attitude is the [`AttitudeEstimator`]'s.
 
 use protocol::{Imu, Joints, Leg, LegFeedback, WheelFeedback};
 
 use crate::attitude::Attitude;
+use crate::control::estimator::{AttitudeEstimator, Motion};
 use crate::control::safety::Watchdog;
 use crate::time::Tick;
 
@@ -15,18 +17,22 @@ pub struct Sensors {
     pub joint_velocity_rad_s: Joints<f32>,
     /// Wheel joint rates (left, right), relative to the body, rad/s.
     pub wheel_rate_rad_s: [f32; 2],
-    /// Torso attitude.
+    /// Torso attitude (the estimator's; level before the first IMU sample).
     pub attitude: Attitude,
-    /// Body rates about x, y, z, rad/s.
+    /// Body rates about x, y, z with the estimated gyro bias removed, rad/s.
     pub angular_rate_rad_s: [f32; 3],
+    estimator: AttitudeEstimator,
+    /// The IMU sample received this tick, for [`Sensors::estimate`]: tick, gyro, accelerometer.
+    imu_sample: Option<(Tick, [f32; 3], [f32; 3])>,
     legs: [Watchdog; 4],
     wheels: Watchdog,
     imu: Watchdog,
 }
 
 impl Sensors {
-    /// Nothing received yet; watchdogs of `feedback_ticks` (drives) and `imu_ticks`.
-    pub const fn new(feedback_ticks: u32, imu_ticks: u32) -> Self {
+    /// Nothing received yet; watchdogs of `feedback_ticks` (drives) and `imu_ticks`; the IMU's
+    /// samples go through `estimator`.
+    pub const fn new(feedback_ticks: u32, imu_ticks: u32, estimator: AttitudeEstimator) -> Self {
         Self {
             joint_position_rad: Joints::splat(0.0),
             joint_velocity_rad_s: Joints::splat(0.0),
@@ -36,6 +42,8 @@ impl Sensors {
                 roll_rad: 0.0,
             },
             angular_rate_rad_s: [0.0; 3],
+            estimator,
+            imu_sample: None,
             legs: [Watchdog::new(feedback_ticks); 4],
             wheels: Watchdog::new(feedback_ticks),
             imu: Watchdog::new(imu_ticks),
@@ -57,19 +65,40 @@ impl Sensors {
         self.wheels.feed(now);
     }
 
-    /// Stores an IMU sample. An all-zero sample (what an IMU that is not initialised or broken
-    /// sends: no rotation, no rate, and no specific force, which a robot on the ground always
-    /// feels) does not count as a sample; neither does a quaternion that gives no attitude.
+    /// Keeps an IMU sample for this tick's [`Sensors::estimate`] and feeds the IMU watchdog.
+    /// An all-zero sample (what an IMU that is not initialised or broken sends: no rate and
+    /// no specific force, which a robot on the ground always feels) is no sample.
     pub fn record_imu(&mut self, now: Tick, imu: &Imu) {
-        let zero = imu.orientation.iter().all(|c| c.raw() == 0)
-            && imu.angular_rate.iter().all(|w| w.raw() == 0)
+        let zero = imu.angular_rate.iter().all(|w| w.raw() == 0)
             && imu.acceleration.iter().all(|a| a.raw() == 0);
-        let attitude = Attitude::from_quaternion(imu.quaternion(crate::math::sqrt));
-        if !zero && attitude.tilt_rad().is_finite() {
-            self.attitude = attitude;
-            self.angular_rate_rad_s = imu.angular_rate.map(|w| w.si());
+        if !zero {
+            let gyro = imu.angular_rate.map(|w| w.si());
+            let accel = imu.acceleration.map(|a| a.si());
+            self.imu_sample = Some((now, gyro, accel));
             self.imu.feed(now);
         }
+    }
+
+    /// Runs this tick's IMU sample, if any, through the attitude estimator with the torso's
+    /// `motion`.
+    pub fn estimate(&mut self, motion: Motion) {
+        if let Some((tick, gyro, accel)) = self.imu_sample.take() {
+            if self.estimator.update(tick, gyro, accel, motion) {
+                self.attitude = self.estimator.attitude();
+                self.angular_rate_rad_s = self.estimator.rate_rad_s();
+            }
+        }
+    }
+
+    /// Whether there is an attitude to act on: the IMU talks and its estimator has started
+    /// (until then [`Sensors::attitude`] is level, a placeholder).
+    pub fn attitude_known(&self, now: Tick) -> bool {
+        !self.imu.expired(now) && self.estimator.started()
+    }
+
+    /// The attitude estimator (its bias estimate, whether it has calibrated).
+    pub fn estimator(&self) -> &AttitudeEstimator {
+        &self.estimator
     }
 
     /// Whether every leg and the wheels have reported at least once.
@@ -113,27 +142,33 @@ pub const fn leg_index(leg: Leg) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use protocol::{Acceleration, AngularRate, QuatComponent};
+    use crate::control::estimator::EstimatorConfig;
+    use crate::time::TickRate;
+    use protocol::{Acceleration, AngularRate};
 
     #[test]
     fn an_all_zero_imu_sample_feeds_no_watchdog_and_a_level_one_does() {
-        let mut sensors = Sensors::new(10, 10);
+        let estimator = AttitudeEstimator::new(EstimatorConfig::ROBOT, TickRate::SIM_250_HZ);
+        let mut sensors = Sensors::new(10, 10, estimator);
         let zero = Imu {
-            orientation: [QuatComponent::saturating_from_si(0.0); 3],
             angular_rate: [AngularRate::saturating_from_si(0.0); 3],
             acceleration: [Acceleration::saturating_from_si(0.0); 3],
         };
         for t in 0..20 {
             sensors.record_imu(Tick(t), &zero);
+            sensors.estimate(Motion::default());
         }
         assert!(sensors.imu_stale(Tick(20)), "zeros are no IMU");
-        // Level and at rest: the same quaternion, with gravity felt.
+        // Level and at rest: gravity felt.
         let level = Imu {
             acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
             ..zero
         };
+        assert!(!sensors.attitude_known(Tick(20)));
         sensors.record_imu(Tick(20), &level);
+        sensors.estimate(Motion::default());
         assert!(!sensors.imu_stale(Tick(21)));
+        assert!(sensors.attitude_known(Tick(21)));
         assert_eq!(sensors.attitude.tilt_rad(), 0.0);
     }
 }

@@ -66,6 +66,11 @@ impl SupportGeometry {
     /// Whether the wheels are on the ground (the legs hold the torso no higher than the wheels'
     /// contact height + margin).
     pub fn wheels_grounded(&self, geometry: &LegGeometry, joints_rad: &Joints<f32>) -> bool {
-        self.leg_height_m(geometry, joints_rad) <= self.wheel_contact_height_m + self.margin_m
+        self.grounds_wheels(&self.stance_of(geometry, joints_rad))
+    }
+
+    /// Whether legs in `stance` leave the wheels on the ground.
+    pub fn grounds_wheels(&self, stance: &LegStance) -> bool {
+        stance.height_m <= self.wheel_contact_height_m + self.margin_m
     }
 }

@@ -1,18 +1,21 @@
 //! A controller on an ideal plant (every drive reaches its target at once, the torso stays
-//! level, the operator's heartbeat arrives every 5 ticks), for the step-by-step tests.
+//! level or turns as a gyro and an accelerometer report it, the operator's heartbeat arrives
+//! every 5 ticks), for the step-by-step tests.
 
 use firmware::control::controller::Output;
 use firmware::control::fsm::State;
 use firmware::{Config, Controller, Tick};
 use protocol::{
-    AnyMessage, EStop, EStopAction, Joints, NodeId, ReleaseToken, TeleopHeartbeat, TeleopMode,
+    AngularRate, AnyMessage, EStop, EStopAction, Imu, Joints, NodeId, ReleaseToken,
+    TeleopHeartbeat, TeleopMode,
 };
 
 use super::{command, imu, leg_feedback, Ticks};
 
 pub const CONFIG: Config = Config::ROBOT;
 
-/// A plant whose drives reach their targets at once and whose torso stays level.
+/// A plant whose drives reach their targets at once and whose torso stays level, or turns to
+/// `pitch_rad` at up to [`FALL_RAD_S`] as a gyro and an accelerometer would report it.
 pub struct Bench {
     pub controller: Controller,
     pub now: u32,
@@ -21,7 +24,12 @@ pub struct Bench {
     pub imu_alive: bool,
     pub teleop_alive: bool,
     pub pitch_rad: f32,
+    /// Where the torso is on its way to `pitch_rad`.
+    pub torso_pitch_rad: f32,
 }
+
+/// How fast the bench's torso turns to a new pitch, rad/s (a fall).
+pub const FALL_RAD_S: f32 = 10.0;
 
 /// A latch, or a release (the controller takes any token: the node checks it).
 pub fn estop(action: EStopAction) -> AnyMessage {
@@ -43,6 +51,7 @@ impl Bench {
             imu_alive: true,
             teleop_alive: true,
             pitch_rad: 0.0,
+            torso_pitch_rad: 0.0,
         }
     }
 
@@ -70,9 +79,16 @@ impl Bench {
             self.controller
                 .on_message(now, &super::wheels_at(wheels_rad_s));
         }
+        let dt_s = CONFIG.rate.period_s();
+        let max_step = FALL_RAD_S * dt_s;
+        let step = (self.pitch_rad - self.torso_pitch_rad).clamp(-max_step, max_step);
+        self.torso_pitch_rad += step;
         if self.imu_alive {
-            self.controller
-                .on_message(now, &AnyMessage::Imu(imu(self.pitch_rad)));
+            let sample = Imu {
+                angular_rate: [0.0, step / dt_s, 0.0].map(AngularRate::saturating_from_si),
+                ..imu(self.torso_pitch_rad)
+            };
+            self.controller.on_message(now, &AnyMessage::Imu(sample));
         }
         if self.teleop_alive && self.now % 5 == 0 {
             self.controller.on_message(

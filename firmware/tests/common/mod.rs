@@ -91,13 +91,14 @@ pub fn following_wheels_rad_s(controller: &firmware::Controller) -> f32 {
     controller.balance().velocity_ref_m_s() / r
 }
 
-/// An IMU sample of a torso pitched by `pitch_rad`, still, in 1 g.
+/// An IMU sample of a torso pitched by `pitch_rad` (nose down), still, in 1 g: the specific
+/// force points up, `g (−sin θ, 0, cos θ)` in the body frame.
 pub fn imu(pitch_rad: f32) -> Imu {
-    let half = 0.5 * pitch_rad;
+    let g = 9.806_65;
     Imu {
-        orientation: Imu::orientation_of([half.cos(), 0.0, half.sin(), 0.0]),
         angular_rate: [AngularRate::saturating_from_si(0.0); 3],
-        acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
+        acceleration: [-g * pitch_rad.sin(), 0.0, g * pitch_rad.cos()]
+            .map(Acceleration::saturating_from_si),
     }
 }
 

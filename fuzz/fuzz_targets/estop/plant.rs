@@ -98,11 +98,12 @@ impl Plant {
             velocity: [WheelVelocity::saturating_from_si(self.wheel_rad_s); 2],
             effort: [Torque::saturating_from_si(0.0); 2],
         }));
-        let half = 0.5 * self.pitch_rad;
+        // Still, pitched by `pitch_rad`: the chip feels the specific force g (−sin θ, 0, cos θ).
+        let g = 9.806_65;
+        let (sin, cos) = (self.pitch_rad.sin(), self.pitch_rad.cos());
         messages.push(AnyMessage::Imu(Imu {
-            orientation: Imu::orientation_of([half.cos(), 0.0, half.sin(), 0.0]),
             angular_rate: [AngularRate::saturating_from_si(0.0); 3],
-            acceleration: [0.0, 0.0, 9.81].map(Acceleration::saturating_from_si),
+            acceleration: [-g * sin, 0.0, g * cos].map(Acceleration::saturating_from_si),
         }));
         messages
     }

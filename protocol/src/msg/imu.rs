@@ -3,19 +3,21 @@ use serde::{Deserialize, Serialize};
 use crate::codec::{check_layout, Message};
 use crate::id::MessageId;
 use crate::signal::{array, Field};
-use crate::units::{Acceleration, AngularRate, QuatComponent};
+use crate::units::{Acceleration, AngularRate};
 
-/// Torso IMU sample, id `0x185`, IMU → controller. Body frame: x forward, y left, z up.
+/// Torso IMU sample, id `0x185`, IMU → controller: what the chip measures, no orientation (the
+/// controller estimates its attitude from these). Body frame: x forward, y left, z up.
 ///
-/// | byte  | field          | type    | meaning                                            |
-/// |-------|----------------|---------|----------------------------------------------------|
-/// | 6–11  | `orientation`  | 3 × i16 | quaternion x, y, z (world ← body); 1e-4, ±1         |
-/// | 12–17 | `angular_rate` | 3 × i16 | gyro x, y, z; 1e-3 rad/s                            |
-/// | 18–23 | `acceleration` | 3 × i16 | accelerometer x, y, z (specific force); 1e-2 m/s²   |
+/// | byte  | field          | type    | meaning                                              |
+/// |-------|----------------|---------|------------------------------------------------------|
+/// | 6–11  | `angular_rate` | 3 × i16 | gyro x, y, z; 1e-3 rad/s, ±32.767 rad/s               |
+/// | 12–17 | `acceleration` | 3 × i16 | accelerometer x, y, z (specific force); 1e-2 m/s², ±327.67 m/s² |
 ///
-/// The quaternion's w is not sent: the IMU sends the sign of the unit quaternion with w ≥ 0
-/// (both signs are the same rotation), so w = √(1 − x² − y² − z²) ([`Imu::quaternion`]). The
-/// 24-byte frame keeps the 1 kHz schedule's busiest cycle within half the bus.
+/// The scales fit the robot's chip, a Bosch BMI088 at ±1000 °/s and ±6 g (see
+/// `docs/simulator.md`): both ranges lie inside the fields' (±17.5 rad/s, ±58.8 m/s²), and
+/// each step is below the chip's noise at its output rate (gyro 1e-3 rad/s against 4.1e-3
+/// rad/s RMS, accelerometer 1e-2 m/s² against 2.7e-2 m/s² RMS), so rounding adds under 3 % to
+/// the noise's RMS. The 18-byte frame goes out as a 20-byte CAN FD frame.
 #[derive(
     Debug,
     Clone,
@@ -27,20 +29,17 @@ use crate::units::{Acceleration, AngularRate, QuatComponent};
     postcard::experimental::max_size::MaxSize,
 )]
 pub struct Imu {
-    /// Orientation quaternion x, y, z (w ≥ 0 implied).
-    pub orientation: [QuatComponent; 3],
     /// Angular rate about x, y, z.
     pub angular_rate: [AngularRate; 3],
-    /// Specific force along x, y, z.
+    /// Specific force along x, y, z (at rest: +g along up).
     pub acceleration: [Acceleration; 3],
 }
 
 impl Message for Imu {
     type Address = ();
     const NAME: &'static str = "Imu";
-    const DOC: &'static str = "Torso orientation, angular rate and acceleration";
+    const DOC: &'static str = "Torso angular rate and specific force";
     const FIELDS: &'static [Field] = &[
-        array::<QuatComponent>("orientation", &["x", "y", "z"]),
         array::<AngularRate>("angular_rate", &["x", "y", "z"]),
         array::<Acceleration>("acceleration", &["x", "y", "z"]),
     ];
@@ -49,23 +48,3 @@ impl Message for Imu {
     }
 }
 check_layout!(Imu);
-
-impl Imu {
-    /// The unit quaternion w, x, y, z of a full orientation `[w, x, y, z]` (either sign), as
-    /// sent: the sign with w ≥ 0, w dropped.
-    pub fn orientation_of(q: [f32; 4]) -> [QuatComponent; 3] {
-        let [w, x, y, z] = q;
-        let sign = if w < 0.0 { -1.0 } else { 1.0 };
-        [x, y, z].map(|c| QuatComponent::saturating_from_si(sign * c))
-    }
-
-    /// The orientation as a quaternion w, x, y, z, with w ≥ 0 recovered from x, y, z by
-    /// `sqrt` (the caller's: the MCU has a square-root instruction); w is 0 when wire rounding
-    /// puts x² + y² + z² above 1.
-    pub fn quaternion(&self, sqrt: impl Fn(f32) -> f32) -> [f32; 4] {
-        let [x, y, z] = self.orientation.map(|c| c.si());
-        let w_sq = 1.0 - (x * x + y * y + z * z);
-        let w = if w_sq > 0.0 { sqrt(w_sq) } else { 0.0 };
-        [w, x, y, z]
-    }
-}

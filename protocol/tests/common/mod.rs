@@ -25,7 +25,6 @@ raw_strategy!(wheel_angle, WheelAngle, i16);
 raw_strategy!(joint_velocity, JointVelocity, i16);
 raw_strategy!(wheel_velocity, WheelVelocity, i16);
 raw_strategy!(torque, Torque, i16);
-raw_strategy!(quat, QuatComponent, i16);
 raw_strategy!(rate, AngularRate, i16);
 raw_strategy!(accel, Acceleration, i16);
 raw_strategy!(height, BodyHeight, i16);
@@ -88,17 +87,13 @@ pub fn any_message() -> impl Strategy<Value = AnyMessage> {
                 |(velocity, effort)| AnyMessage::WheelFeedback(WheelFeedback { velocity, effort })
             ),
         (
-            proptest::array::uniform3(quat()),
             proptest::array::uniform3(rate()),
             proptest::array::uniform3(accel())
         )
-            .prop_map(
-                |(orientation, angular_rate, acceleration)| AnyMessage::Imu(Imu {
-                    orientation,
-                    angular_rate,
-                    acceleration
-                })
-            ),
+            .prop_map(|(angular_rate, acceleration)| AnyMessage::Imu(Imu {
+                angular_rate,
+                acceleration
+            })),
         (pick(TeleopMode::ALL), height(), speed()).prop_map(|(mode, body_height, speed_scale)| {
             AnyMessage::TeleopCommand(TeleopCommand {
                 mode,

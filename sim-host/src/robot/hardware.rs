@@ -42,7 +42,7 @@ impl Hardware {
             wheel: WheelDrive::new(key)
                 .rated(plant.drives.wheel)
                 .sensing(&plant.sensing),
-            imu: ImuNode::new(plant.imu_noise, key),
+            imu: ImuNode::new(plant.imu, plant.imu_noise, key),
             control_hz,
             controller_mode: None,
         }
@@ -56,6 +56,11 @@ impl Hardware {
     /// The wheel drive.
     pub fn wheel(&self) -> &WheelDrive {
         &self.wheel
+    }
+
+    /// The IMU node.
+    pub fn imu(&self) -> &ImuNode {
+        &self.imu
     }
 
     /// The controller's mode from its last status frame.
@@ -135,7 +140,7 @@ impl Hardware {
                     self.wheel.core_mut().seal(&message)?
                 }
                 MessageId::Imu => {
-                    let message = self.imu.sample(physics);
+                    let message = self.imu.sample(now_us, physics);
                     self.imu.seal(&message)?
                 }
                 MessageId::DriveStatus(drive) => {

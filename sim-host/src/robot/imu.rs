@@ -1,5 +1,7 @@
-//! The torso IMU as a CAN node: MuJoCo's ideal framequat / gyro / accelerometer readings plus
-//! optional white noise and constant bias (default off), published as `Imu` frames.
+//! The torso IMU as a CAN node: MuJoCo's ideal gyro and accelerometer readings, through the
+//! chip's model ([`crate::robot::imu_chip`], the default) or straight ([`ImuModel::Ideal`]),
+//! plus optional extra white noise and constant bias (default off), published as `Imu` frames
+//! of angular rate and specific force.
 
 use rand::rngs::SmallRng;
 use rand::SeedableRng;
@@ -7,11 +9,23 @@ use rand_distr::{Distribution, Normal};
 
 use protocol::{Acceleration, AngularRate, AnyMessage, EncodeError, Frame, Imu, Key, MessageId};
 
+use crate::robot::imu_chip::{ChipSpec, ImuChip};
 use crate::robot::link::NodeLink;
-
 use crate::robot::physics::Physics;
 
-/// Noise and bias of the IMU. All zero by default: the ideal sensor.
+/// What sits between the simulated truth and the wire.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum ImuModel {
+    /// A real part: noise, turn-on bias and its walk, range, resolution, sample rate and filter
+    /// delay (see [`crate::robot::imu_chip`]).
+    Chip(ChipSpec),
+    /// A perfect chip: the true rate and specific force at the moment of sending (for
+    /// debugging a controller).
+    Ideal,
+}
+
+/// Extra noise and bias on top of the model, added to the truth before the chip. All zero by
+/// default.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ImuNoise {
     /// White noise on each gyro axis, standard deviation, rad/s.
@@ -22,9 +36,8 @@ pub struct ImuNoise {
     pub accel_std_m_s2: f64,
     /// Constant accelerometer bias, x y z, m/s².
     pub accel_bias_m_s2: [f64; 3],
-    /// Orientation noise: a random small rotation about each body axis, standard deviation, rad.
-    pub orientation_std_rad: f64,
-    /// Seed of the noise generator, so that noisy runs repeat exactly.
+    /// Seed of the noise generator and of the chip's biases and noise, so that runs repeat
+    /// exactly.
     pub seed: u64,
 }
 
@@ -33,17 +46,29 @@ pub struct ImuNoise {
 pub struct ImuNode {
     noise: ImuNoise,
     rng: SmallRng,
+    chip: Option<ImuChip>,
     link: NodeLink,
 }
 
 impl ImuNode {
-    /// An IMU with `noise` that joins the sessions it hears with `key`.
-    pub fn new(noise: ImuNoise, key: Key) -> Self {
+    /// An IMU of `model` with extra `noise` that joins the sessions it hears with `key`.
+    pub fn new(model: ImuModel, noise: ImuNoise, key: Key) -> Self {
+        let chip = match model {
+            ImuModel::Chip(spec) => Some(ImuChip::new(spec, noise.seed)),
+            ImuModel::Ideal => None,
+        };
         Self {
             noise,
-            rng: SmallRng::seed_from_u64(noise.seed),
+            // A stream of its own, so that the extras do not shift the chip's draws.
+            rng: SmallRng::seed_from_u64(noise.seed ^ 0x1A2B_3C4D_5E6F_7081),
+            chip,
             link: NodeLink::new(key),
         }
+    }
+
+    /// The chip, if the model has one (its biases, for tests and diagnostics).
+    pub fn chip(&self) -> Option<&ImuChip> {
+        self.chip.as_ref()
     }
 
     /// Takes a frame from the bus: the IMU listens to the controller's announcement only.
@@ -67,15 +92,10 @@ impl ImuNode {
         }
     }
 
-    /// One sample of the current state.
-    pub fn sample(&mut self, physics: &Physics) -> AnyMessage {
-        let (quat, gyro, accel) = physics.imu();
+    /// The sample the node sends at `now_us`: the chip's newest output for the current state.
+    pub fn sample(&mut self, now_us: u64, physics: &Physics) -> AnyMessage {
+        let (_, gyro, accel) = physics.imu();
         let n = self.noise;
-        let mut rotation = [0.0; 3];
-        for axis in &mut rotation {
-            *axis = self.gaussian(n.orientation_std_rad);
-        }
-        let quat = perturb(quat, rotation);
         let mut rate = gyro;
         for (value, bias) in rate.iter_mut().zip(n.gyro_bias_rad_s) {
             *value += bias + self.gaussian(n.gyro_std_rad_s);
@@ -84,28 +104,13 @@ impl ImuNode {
         for (value, bias) in force.iter_mut().zip(n.accel_bias_m_s2) {
             *value += bias + self.gaussian(n.accel_std_m_s2);
         }
+        let (rate, force) = match &mut self.chip {
+            Some(chip) => chip.read(now_us as f64 * 1e-6, rate, force),
+            None => (rate, force),
+        };
         AnyMessage::Imu(Imu {
-            orientation: Imu::orientation_of(quat.map(|c| c as f32)),
             angular_rate: rate.map(|r| AngularRate::saturating_from_si(r as f32)),
             acceleration: force.map(|a| Acceleration::saturating_from_si(a as f32)),
         })
     }
-}
-
-/// `q ⊗ δq` with `δq` the small rotation `v` (body frame), normalised.
-fn perturb(q: [f64; 4], v: [f64; 3]) -> [f64; 4] {
-    if v == [0.0; 3] {
-        return q;
-    }
-    let d = [1.0, 0.5 * v[0], 0.5 * v[1], 0.5 * v[2]];
-    let [w1, x1, y1, z1] = q;
-    let [w2, x2, y2, z2] = d;
-    let r = [
-        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
-    ];
-    let norm = r.iter().map(|c| c * c).sum::<f64>().sqrt();
-    r.map(|c| c / norm)
 }

@@ -1,11 +1,12 @@
 //! The robot: its MuJoCo [`model`] and [`physics`] (ground truth), and the hardware a real
 //! robot puts on the bus, emulated — four [`leg_drive`]s and the [`wheel_drive`] (sharing
-//! [`drive_core`], each at its [`rating`], measuring as [`sensing`] says), the [`imu`], all
-//! together in [`hardware`]; the [`plant`] picks the parts.
+//! [`drive_core`], each at its [`rating`], measuring as [`sensing`] says), the [`imu`] (its chip:
+//! [`imu_chip`]), all together in [`hardware`]; the [`plant`] picks the parts.
 
 pub mod drive_core;
 pub mod hardware;
 pub mod imu;
+pub mod imu_chip;
 pub mod leg_drive;
 pub mod link;
 pub mod model;

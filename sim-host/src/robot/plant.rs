@@ -1,10 +1,12 @@
-//! What the emulated hardware is made of, for a run: the IMU's noise, the drives' ratings and
-//! sensing, the bus's transport delay, and how the body differs from the model.
-//! The tested default is [`Plant::default`]; the ideal parts stay for debugging a controller.
+//! What the emulated hardware is made of, for a run: the IMU's chip and extra noise, the
+//! drives' ratings and sensing, the bus's transport delay, and how the body differs from the
+//! model. The tested default is [`Plant::default`]; the ideal parts stay for debugging a
+//! controller.
 
 use host_can::fault_plan::Faults;
 
-use crate::robot::imu::ImuNoise;
+use crate::robot::imu::{ImuModel, ImuNoise};
+use crate::robot::imu_chip::ChipSpec;
 use crate::robot::rating::Rating;
 use crate::robot::sensing::DriveSensing;
 use crate::robot::variation::Variation;
@@ -36,7 +38,9 @@ impl DriveRatings {
 /// The parts of one run's emulated hardware.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Plant {
-    /// What the IMU adds to the truth.
+    /// The IMU's chip (or a perfect one).
+    pub imu: ImuModel,
+    /// Extra noise and bias on the IMU, and the seed of its chip.
     pub imu_noise: ImuNoise,
     /// What the drives can deliver.
     pub drives: DriveRatings,
@@ -65,13 +69,20 @@ impl Plant {
 }
 
 impl Default for Plant {
-    /// The tested default: rated drives ([`DriveRatings::RATED`]) that measure with real
-    /// encoders ([`DriveSensing::REAL`]). No transport delay yet: with a cycle of delay the
-    /// drives hear an E-stop latch a cycle late (their own cut then comes after the deadline;
-    /// the wheel command has no torque-off to send earlier).
+    /// The tested default: the IMU is a real chip ([`ChipSpec::BMI088`]), the part drawn with
+    /// seed 1 — the same chip as `sim-host run`'s default `--seed 1` (see `docs/simulator.md`
+    /// for what other draws do to the acceptance figures) — and rated drives
+    /// ([`DriveRatings::RATED`]) that measure with real encoders ([`DriveSensing::REAL`]). No
+    /// transport delay yet: with a cycle of delay the drives hear an E-stop latch a cycle late
+    /// (their own cut then comes after the deadline; the wheel command has no torque-off to send
+    /// earlier).
     fn default() -> Self {
         Self {
-            imu_noise: ImuNoise::default(),
+            imu: ImuModel::Chip(ChipSpec::BMI088),
+            imu_noise: ImuNoise {
+                seed: 1,
+                ..ImuNoise::default()
+            },
             drives: DriveRatings::RATED,
             sensing: DriveSensing::REAL,
             transport_delay_cycles: 0,

@@ -5,7 +5,6 @@ use protocol::Joints;
 
 use super::Controller;
 use crate::control::fsm::State;
-use crate::legs::support::LegStance;
 use crate::legs::transfer::Transfer;
 use crate::time::Tick;
 
@@ -102,30 +101,6 @@ impl Controller {
         }
     }
 
-    /// On the wheels the balance law always runs; while folding or standing up only once the
-    /// measured leg pose puts the wheels on the ground (see [`crate::legs::support`]).
-    pub(super) fn wheels_may_drive(&mut self) -> bool {
-        if matches!(self.state, State::Wheels(_)) {
-            return true;
-        }
-        let support = self.config.support;
-        self.leg_height() <= support.wheel_contact_height_m + support.margin_m
-    }
-
-    /// The torso height the measured legs give, m.
-    fn leg_height(&mut self) -> f32 {
-        self.stance().height_m
-    }
-
-    /// Where the measured legs put the feet: the legs' kinematics cost ~700 instructions a
-    /// leg on the MCU, so once a tick.
-    fn stance(&mut self) -> LegStance {
-        let (config, joints) = (&self.config, &self.sensors.joint_position_rad);
-        *self
-            .leg_stance
-            .get_or_insert_with(|| config.support.stance_of(&config.geometry, joints))
-    }
-
     /// Whether a fold or a stand-up has the robot on its wheels while its feet carry part of
     /// it: the wheels then hold still (a stool on wheels and feet); the balance law takes over
     /// once a fold's tuck lifts the feet clear, and a stand-up's legs lift the wheels off. Balancing on wheels and feet, the law read the lean
@@ -136,7 +111,7 @@ impl Controller {
             return false;
         }
         let support = self.config.support;
-        self.leg_height() >= support.wheel_contact_height_m - support.margin_m
+        self.stance().height_m >= support.wheel_contact_height_m - support.margin_m
     }
 
     /// Whether a running transition is over (checked after this tick's goal and move, so the

@@ -44,7 +44,9 @@ impl Controller {
         if self.sensors.drives_stale(now) {
             faults = faults.with(FaultFlags::FEEDBACK_TIMEOUT);
         }
-        if self.sensors.imu_stale(now) {
+        if self.sensors.imu_stale(now)
+            || (!self.sensors.attitude_known(now) && self.needs_attitude())
+        {
             faults = faults.with(FaultFlags::IMU_TIMEOUT);
         }
         if self.tilted {

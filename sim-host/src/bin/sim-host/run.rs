@@ -8,7 +8,8 @@ use std::time::Duration;
 
 use clap::ValueEnum;
 use host_can::fault_plan::Faults;
-use sim_host::robot::imu::ImuNoise;
+use sim_host::robot::imu::{ImuModel, ImuNoise};
+use sim_host::robot::imu_chip::ChipSpec;
 use sim_host::robot::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
 use sim_host::robot::plant::{DriveRatings, Plant};
 use sim_host::robot::sensing::DriveSensing;
@@ -26,6 +27,16 @@ pub(crate) enum ClockArg {
     /// Steps on the wall clock at the control rate; reports real-time factor and overruns.
     #[value(alias = "realtime")]
     Wall,
+}
+
+/// What the emulated IMU measures with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum ImuArg {
+    /// A Bosch BMI088: noise, turn-on bias and drift, range, resolution, sample rate, filter
+    /// delay.
+    Chip,
+    /// A perfect chip: the true rate and specific force (for debugging).
+    Ideal,
 }
 
 /// What the emulated drives can deliver.
@@ -104,18 +115,25 @@ pub(crate) struct RunArgs {
     /// Lockstep: how long to wait for the controller's command each cycle, ms.
     #[arg(long, default_value_t = 100)]
     pub(crate) reply_timeout_ms: u64,
-    /// IMU gyro white noise, standard deviation, rad/s (`--gyro-noise`: the old name).
+    /// Extra IMU gyro white noise on top of the chip's, standard deviation, rad/s
+    /// (`--gyro-noise`: the old name).
     #[arg(long, default_value_t = 0.0, alias = "gyro-noise")]
     pub(crate) gyro_noise_rad_s: f64,
-    /// IMU gyro bias on every axis, rad/s (`--gyro-bias`: the old name).
+    /// Extra IMU gyro bias on every axis, rad/s (`--gyro-bias`: the old name).
     #[arg(long, default_value_t = 0.0, alias = "gyro-bias")]
     pub(crate) gyro_bias_rad_s: f64,
-    /// IMU accelerometer white noise, standard deviation, m/s² (`--accel-noise`: the old name).
+    /// Extra IMU accelerometer white noise, standard deviation, m/s² (`--accel-noise`: the old
+    /// name).
     #[arg(long, default_value_t = 0.0, alias = "accel-noise")]
     pub(crate) accel_noise_m_s2: f64,
-    /// Seed of the IMU noise.
+    /// Seed of the IMU chip's turn-on bias and noise (and of the extra noise above).
     #[arg(long, default_value_t = 1)]
     pub(crate) seed: u64,
+    /// What the IMU measures with: `chip` (a Bosch BMI088 with its data sheet's noise, turn-on
+    /// bias and drift, ±1000 °/s and ±6 g at 16 bits, 2 kHz / 1.6 kHz sampling, ~1 ms filter
+    /// delay) or `ideal` (the true rate and specific force, for debugging).
+    #[arg(long, value_enum, default_value_t = ImuArg::Chip)]
+    pub(crate) imu: ImuArg,
     /// What the drives can deliver: `rated` (a quasi-direct-drive leg actuator, 33.5 N·m peak
     /// with its torque-speed line and thermal foldback; 30 N·m hub motors) or `ideal` (the
     /// report's unlimited leg servos, flat 30 N·m wheels, for debugging).
@@ -277,6 +295,10 @@ fn session_config(args: &RunArgs, scenario: Option<&Scenario>, duration_s: f64) 
         reply_timeout: Duration::from_millis(args.reply_timeout_ms),
         max_speed: args.pace,
         plant: Plant {
+            imu: match args.imu {
+                ImuArg::Chip => ImuModel::Chip(ChipSpec::BMI088),
+                ImuArg::Ideal => ImuModel::Ideal,
+            },
             imu_noise: ImuNoise {
                 gyro_std_rad_s: args.gyro_noise_rad_s,
                 gyro_bias_rad_s: [args.gyro_bias_rad_s; 3],

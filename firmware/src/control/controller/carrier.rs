@@ -1,0 +1,77 @@
+//! What carries the robot — its legs or its wheels — and what follows for the wheel law and
+//! the attitude estimator: whether the balance law may drive, whether the robot still rolls,
+//! whether an attitude is needed, and the torso's own acceleration on the wheels.
+//!
+//! The legs' kinematics that decide it cost ~700 instructions a leg on the MCU, so they run at
+//! most once a tick, and only where the answer is not given by the state: between the legs and
+//! the wheels (folding, standing up, a controlled stop).
+
+use super::Controller;
+use crate::control::estimator::Motion;
+use crate::control::fsm::State;
+use crate::legs::support::LegStance;
+
+impl Controller {
+    /// What the attitude estimator should know of the torso's own acceleration this tick: on
+    /// the wheels while the balance law drives them, the change of the ground speed
+    /// `r (ω + θ̇)` over the tick. Run first in the tick; on the legs it costs no kinematics.
+    pub(super) fn motion(&mut self) -> Motion {
+        if !(self.balancing() && self.wheels_may_drive()) {
+            self.last_ground_m_s = None;
+            return Motion::default();
+        }
+        let ground_m_s = self.ground_speed_m_s();
+        let hz = self.config.rate.hz() as f32;
+        let accel = self
+            .last_ground_m_s
+            .map_or(0.0, |last| (ground_m_s - last) * hz);
+        self.last_ground_m_s = Some(ground_m_s).filter(|v| v.is_finite());
+        Motion {
+            on_wheels: true,
+            ground_accel_m_s2: if accel.is_finite() { accel } else { 0.0 },
+        }
+    }
+
+    /// Whether the balance law needs an attitude now: the state balances and the wheels carry
+    /// the robot (as found this tick). Without one (the IMU silent, or its estimator not
+    /// started yet: a robot is not calm in the first tenth of a second after power-up) that is
+    /// a fault; while the legs still carry the robot it is not.
+    pub(super) fn needs_attitude(&self) -> bool {
+        self.state.balancing() && self.wheels_carry()
+    }
+
+    /// Whether the robot still rolls on its wheels (ground speed above 5 cm/s, or turning) while
+    /// they carry it.
+    pub(super) fn rolling(&mut self) -> bool {
+        let r = self.config.balance.wheel_radius_m;
+        let speed_m_s = r * self.sensors.mean_wheel_rate_rad_s();
+        let turn_m_s = r * self.sensors.differential_wheel_rate_rad_s();
+        self.wheels_may_drive() && (speed_m_s.abs() > 0.05 || turn_m_s.abs() > 0.05)
+    }
+
+    /// On the wheels the balance law always runs; while folding or standing up only once the
+    /// measured leg pose puts the wheels on the ground (see [`crate::legs::support`]).
+    pub(super) fn wheels_may_drive(&mut self) -> bool {
+        if !matches!(self.state, State::Wheels(_)) {
+            self.stance();
+        }
+        self.wheels_carry()
+    }
+
+    /// [`Controller::wheels_may_drive`] as far as this tick has found: off the wheels, false
+    /// until the legs' stance has been computed.
+    fn wheels_carry(&self) -> bool {
+        matches!(self.state, State::Wheels(_))
+            || self
+                .leg_stance
+                .is_some_and(|stance| self.config.support.grounds_wheels(&stance))
+    }
+
+    /// Where the measured legs put the feet, computed once a tick.
+    pub(super) fn stance(&mut self) -> LegStance {
+        let (config, joints) = (&self.config, &self.sensors.joint_position_rad);
+        *self
+            .leg_stance
+            .get_or_insert_with(|| config.support.stance_of(&config.geometry, joints))
+    }
+}
