@@ -66,7 +66,7 @@
 //! into a position offset of 2.4 cm per degree.
 
 use crate::attitude::Attitude;
-use crate::math::{asin, atan2, clamp, sqrt};
+use crate::math::{atan2, clamp, sqrt};
 use crate::time::{Tick, TickRate};
 
 /// Standard gravity, m/s².
@@ -330,7 +330,7 @@ impl AttitudeEstimator {
         // The ground's forward direction in the body frame: body x with its vertical part out.
         let level = sqrt((1.0 - ux * ux).max(0.0));
         let forward = if level > 0.1 {
-            [(1.0 - ux * ux) / level, -ux * uy / level, -ux * uz / level]
+            scale([1.0 - ux * ux, -ux * uy, -ux * uz], 1.0 / level)
         } else {
             [0.0; 3]
         };
@@ -395,13 +395,13 @@ impl AttitudeEstimator {
     fn calibrate(&mut self, gyro_rad_s: [f32; 3], accel_m_s2: [f32; 3]) -> Option<[f32; 3]> {
         // Stillness: every reading stays near the window's mean so far (a steady turn keeps
         // the gyro steady but turns the accelerometer, so both are checked).
-        let n = self.still_count.max(1) as f32;
+        // |sum / n − x| ≤ limit, as |sum − n x| ≤ n limit: no division per sample.
+        let n = self.still_count as f32;
         let (turn, push) = (self.config.still_rad_s, self.config.still_m_s2);
         let near = |sum: [f32; 3], x: [f32; 3], limit: f32| {
-            self.still_count == 0
-                || zip3(sum, x, |s, x| s / n - x)
-                    .iter()
-                    .all(|d| d.abs() <= limit)
+            zip3(sum, x, |s, x| s - n * x)
+                .iter()
+                .all(|d| d.abs() <= n * limit)
         };
         let still = self.near_g(sqrt(dot(accel_m_s2, accel_m_s2)))
             && near(self.still_gyro, gyro_rad_s, turn)
@@ -458,11 +458,12 @@ impl AttitudeEstimator {
     }
 }
 
-/// Pitch and roll of the body whose "up" is `up` (unit).
+/// Pitch and roll of the body whose "up" is `up` (unit). Pitch as `atan2`, not `asin`: the
+/// kinematics already link `atan2` into the image, and it needs no clamp.
 fn attitude_of(up: [f32; 3]) -> Attitude {
     let [x, y, z] = up;
     Attitude {
-        pitch_rad: asin(clamp(-x, -1.0, 1.0)),
+        pitch_rad: atan2(-x, sqrt(y * y + z * z)),
         roll_rad: atan2(y, z),
     }
 }
