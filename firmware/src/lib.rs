@@ -11,9 +11,9 @@
 //! | layer | module | what it does |
 //! |---|---|---|
 //! | CAN node | [`node`] ([`node::service`], [`node::rate_limit`], [`node::link`], [`node::persist`]) | frames in (decode, E2E, counted rejects, a per-tick budget for operator commands, the link's loss ratio), frames out on the bus schedule; the one service loop every target runs; the epoch and latch a board keeps across restarts |
-//! | control | [`control`] ([`control::controller`], [`control::fsm`], [`control::safety`], [`control::sensors`], [`control::teleop`]) | the control step (supervisor → FSM → leg goals + smoothing → wheel law → clamps), modes, watchdogs and clamps, operator requests |
+//! | control | [`control`] ([`control::controller`], [`control::fsm`], [`control::safety`], [`control::sensors`], [`control::estimator`], [`control::teleop`]) | the control step (attitude estimate → supervisor → FSM → leg goals + smoothing → wheel law → clamps), modes, watchdogs and clamps, the attitude from the IMU's rate and specific force, operator requests |
 //! | legs | [`legs`] | IK/FK, stance and fold, the trot |
-//! | wheels | [`wheels`] | LQR balance on IMU pitch, turn speed loop, torque mixing |
+//! | wheels | [`wheels`] | LQR balance on the estimated pitch, turn speed loop, torque mixing |
 //! | basics | [`config`], [`limits`], [`math`], [`time`], [`attitude`] | parameters, units, maths choices |
 // Functions stay short enough to read whole (clippy.toml: 80 lines); tests may run longer.
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
