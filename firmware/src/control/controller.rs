@@ -104,7 +104,7 @@ impl Controller {
             sensors: Sensors::new(
                 rate.ticks_from_ms(config.feedback_timeout_ms),
                 rate.ticks_from_ms(config.imu_timeout_ms),
-                AttitudeEstimator::new(config.attitude, rate),
+                AttitudeEstimator::new(&config.attitude, rate),
             ),
             teleop: Teleop::new(rate.ticks_from_ms(config.teleop_timeout_ms)),
             trot,
@@ -237,7 +237,7 @@ impl Controller {
     pub fn step(&mut self, now: Tick) -> Output {
         self.leg_stance = None;
         let motion = self.motion();
-        self.sensors.estimate(motion);
+        self.sensors.estimate(&self.config.attitude, motion);
         self.supervise(now);
         if !self.armed {
             self.follow_measured();

@@ -65,9 +65,12 @@
 //! 1σ, is 1.1°). On the wheels that becomes a static pitch error, which the balance law turns
 //! into a position offset of 2.4 cm per degree.
 
+mod vector;
+
 use crate::attitude::Attitude;
 use crate::math::{atan2, clamp, sqrt};
 use crate::time::{Tick, TickRate};
+use vector::{cross, dot, normalise, scale, zip3};
 
 /// Standard gravity, m/s².
 pub const GRAVITY_M_S2: f32 = 9.806_65;
@@ -159,7 +162,6 @@ impl EstimatorConfig {
 /// The running filter.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AttitudeEstimator {
-    config: EstimatorConfig,
     period_s: f32,
     still_ticks: u32,
     max_gap_ticks: u32,
@@ -186,10 +188,10 @@ pub struct AttitudeEstimator {
 }
 
 impl AttitudeEstimator {
-    /// A filter with no sample yet, for samples arriving at `rate`.
-    pub fn new(config: EstimatorConfig, rate: TickRate) -> Self {
+    /// A filter with no sample yet, for samples arriving at `rate`, configured as `config`
+    /// (which [`AttitudeEstimator::update`] is given again: the filter keeps no copy).
+    pub fn new(config: &EstimatorConfig, rate: TickRate) -> Self {
         Self {
-            config,
             period_s: rate.period_s(),
             still_ticks: rate.ticks_from_ms(config.still_ms).max(1),
             max_gap_ticks: rate.ticks_from_ms(config.max_gap_ms).max(1),
@@ -240,6 +242,7 @@ impl AttitudeEstimator {
     /// sample in the same tick is ignored.
     pub fn update(
         &mut self,
+        config: &EstimatorConfig,
         now: Tick,
         gyro_rad_s: [f32; 3],
         accel_m_s2: [f32; 3],
@@ -252,13 +255,13 @@ impl AttitudeEstimator {
         let ticks = now.since(self.last);
         let up = match self.up {
             Some(up) if ticks <= self.max_gap_ticks => up,
-            _ => return self.try_start(now, gyro_rad_s, accel_m_s2),
+            _ => return self.try_start(config, now, gyro_rad_s, accel_m_s2),
         };
         if ticks == 0 {
             return false;
         }
         if !self.calibrated {
-            if let Some(still_up) = self.calibrate(gyro_rad_s, accel_m_s2) {
+            if let Some(still_up) = self.calibrate(config, gyro_rad_s, accel_m_s2) {
                 let rate = zip3(gyro_rad_s, self.bias_rad_s, |w, b| w - b);
                 self.finish(now, still_up, rate);
                 return true;
@@ -270,13 +273,13 @@ impl AttitudeEstimator {
             .started_ticks
             .saturating_add(ticks)
             .min(self.start_ticks);
-        let error = self.correction(up, rate, accel_m_s2, dt_s, motion);
+        let error = self.correction(config, up, rate, accel_m_s2, dt_s, motion);
         let (kp, ki) = if self.started_ticks < self.start_ticks {
-            (self.config.kp_start_per_s, 0.0)
+            (config.kp_start_per_s, 0.0)
         } else {
-            (self.config.kp_per_s, self.config.ki_per_s2)
+            (config.kp_per_s, config.ki_per_s2)
         };
-        let (step, limit) = (ki * dt_s, self.config.bias_limit_rad_s);
+        let (step, limit) = (ki * dt_s, config.bias_limit_rad_s);
         self.bias_rad_s = zip3(self.bias_rad_s, error, |b, e| {
             clamp(b - step * e, -limit, limit)
         });
@@ -290,14 +293,15 @@ impl AttitudeEstimator {
     /// taken out, low-passed) crossed with `up`, weighted by how far it can be trusted.
     fn correction(
         &mut self,
+        config: &EstimatorConfig,
         up: [f32; 3],
         rate: [f32; 3],
         accel_m_s2: [f32; 3],
         dt_s: f32,
         motion: Motion,
     ) -> [f32; 3] {
-        let own = self.own_acceleration(up, rate, dt_s, motion);
-        let k = (dt_s / self.config.accel_filter_s).min(1.0);
+        let own = self.own_acceleration(config, up, rate, dt_s, motion);
+        let k = (dt_s / config.accel_filter_s).min(1.0);
         let gravity = zip3(
             self.gravity,
             zip3(accel_m_s2, own, |a, o| a - o),
@@ -305,9 +309,9 @@ impl AttitudeEstimator {
         );
         self.gravity = gravity;
         let norm = sqrt(dot(gravity, gravity));
-        let turn = self.turn_weight(rate);
-        self.track_rest(norm, dt_s, turn >= 1.0);
-        let weight = self.accel_weight(norm) * turn;
+        let turn = turn_weight(config, rate);
+        self.track_rest(config, norm, dt_s, turn >= 1.0);
+        let weight = self.accel_weight(config, norm) * turn;
         if weight > 0.0 {
             scale(cross(scale(gravity, 1.0 / norm), up), weight)
         } else {
@@ -321,6 +325,7 @@ impl AttitudeEstimator {
     /// z; `α` from the change of the rate since the last sample).
     fn own_acceleration(
         &self,
+        config: &EstimatorConfig,
         up: [f32; 3],
         rate: [f32; 3],
         dt_s: f32,
@@ -336,7 +341,7 @@ impl AttitudeEstimator {
         };
         let mut own = scale(forward, motion.ground_accel_m_s2);
         if motion.on_wheels {
-            let h = self.config.imu_above_axle_m;
+            let h = config.imu_above_axle_m;
             let alpha = zip3(rate, self.rate_rad_s, |w, w0| (w - w0) / dt_s);
             let ([wx, wy, wz], [ax, ay, _]) = (rate, alpha);
             let turn = [
@@ -351,18 +356,24 @@ impl AttitudeEstimator {
 
     /// Follows the magnitude the accelerometer reads near g while the torso does not turn (a
     /// chip's offsets move it by a few per cent), slowly.
-    fn track_rest(&mut self, norm: f32, dt_s: f32, quiet: bool) {
-        if quiet && self.near_g(norm) {
-            let k = (dt_s / self.config.rest_s).min(1.0);
+    fn track_rest(&mut self, config: &EstimatorConfig, norm: f32, dt_s: f32, quiet: bool) {
+        if quiet && near_g(config, norm) {
+            let k = (dt_s / config.rest_s).min(1.0);
             self.rest_m_s2 += k * (norm - self.rest_m_s2);
         }
     }
 
     /// (Re)start: up is where the accelerometer points, from a sample that feels about 1 g and
     /// shows no fast turn (not one of a fall).
-    fn try_start(&mut self, now: Tick, gyro_rad_s: [f32; 3], accel_m_s2: [f32; 3]) -> bool {
+    fn try_start(
+        &mut self,
+        config: &EstimatorConfig,
+        now: Tick,
+        gyro_rad_s: [f32; 3],
+        accel_m_s2: [f32; 3],
+    ) -> bool {
         let norm = sqrt(dot(accel_m_s2, accel_m_s2));
-        if !(self.near_g(norm) && self.turn_weight(gyro_rad_s) > 0.0) {
+        if !(near_g(config, norm) && turn_weight(config, gyro_rad_s) > 0.0) {
             return false;
         }
         self.start(now, scale(accel_m_s2, 1.0 / norm), gyro_rad_s);
@@ -392,18 +403,23 @@ impl AttitudeEstimator {
     /// One sample of the start-up calibration. Over a still window the torso does not turn, so
     /// the mean gyro reading is the bias and the mean specific force points up: when the window
     /// completes, the bias is set and the new "up" returned. Any motion restarts the window.
-    fn calibrate(&mut self, gyro_rad_s: [f32; 3], accel_m_s2: [f32; 3]) -> Option<[f32; 3]> {
+    fn calibrate(
+        &mut self,
+        config: &EstimatorConfig,
+        gyro_rad_s: [f32; 3],
+        accel_m_s2: [f32; 3],
+    ) -> Option<[f32; 3]> {
         // Stillness: every reading stays near the window's mean so far (a steady turn keeps
         // the gyro steady but turns the accelerometer, so both are checked).
         // |sum / n − x| ≤ limit, as |sum − n x| ≤ n limit: no division per sample.
         let n = self.still_count as f32;
-        let (turn, push) = (self.config.still_rad_s, self.config.still_m_s2);
+        let (turn, push) = (config.still_rad_s, config.still_m_s2);
         let near = |sum: [f32; 3], x: [f32; 3], limit: f32| {
             zip3(sum, x, |s, x| s - n * x)
                 .iter()
                 .all(|d| d.abs() <= n * limit)
         };
-        let still = self.near_g(sqrt(dot(accel_m_s2, accel_m_s2)))
+        let still = near_g(config, sqrt(dot(accel_m_s2, accel_m_s2)))
             && near(self.still_gyro, gyro_rad_s, turn)
             && near(self.still_accel, accel_m_s2, push);
         if !still {
@@ -424,29 +440,11 @@ impl AttitudeEstimator {
         normalise(mean)
     }
 
-    /// How far the accelerometer is trusted while the torso turns at `gyro_rad_s`, 0…1: a
-    /// turning torso feels the tangential and centripetal accelerations of its turn (a
-    /// balancing robot pitches hardest when it brakes or starts).
-    fn turn_weight(&self, gyro_rad_s: [f32; 3]) -> f32 {
-        let rate = sqrt(dot(gyro_rad_s, gyro_rad_s));
-        let (trust, distrust) = (
-            self.config.turn_trust_rad_s,
-            self.config.turn_distrust_rad_s,
-        );
-        clamp((distrust - rate) / (distrust - trust), 0.0, 1.0)
-    }
-
-    /// Whether specific force `norm` is within [`EstimatorConfig::near_g`] of g: what a still
-    /// torso with any chip's offsets reads.
-    fn near_g(&self, norm: f32) -> bool {
-        (norm / GRAVITY_M_S2 - 1.0).abs() <= self.config.near_g
-    }
-
     /// How far the accelerometer is trusted at specific force `norm`, 0…1: by how far `norm`
     /// is from what it reads at rest.
-    fn accel_weight(&self, norm: f32) -> f32 {
+    fn accel_weight(&self, config: &EstimatorConfig, norm: f32) -> f32 {
         let deviation = (norm / self.rest_m_s2 - 1.0).abs();
-        let (trust, distrust) = (self.config.accel_trust, self.config.accel_distrust);
+        let (trust, distrust) = (config.accel_trust, config.accel_distrust);
         if deviation <= trust {
             1.0
         } else if deviation < distrust {
@@ -458,6 +456,21 @@ impl AttitudeEstimator {
     }
 }
 
+/// How far the accelerometer is trusted while the torso turns at `gyro_rad_s`, 0…1: a turning
+/// torso feels the tangential and centripetal accelerations of its turn (a balancing robot
+/// pitches hardest when it brakes or starts).
+fn turn_weight(config: &EstimatorConfig, gyro_rad_s: [f32; 3]) -> f32 {
+    let rate = sqrt(dot(gyro_rad_s, gyro_rad_s));
+    let (trust, distrust) = (config.turn_trust_rad_s, config.turn_distrust_rad_s);
+    clamp((distrust - rate) / (distrust - trust), 0.0, 1.0)
+}
+
+/// Whether specific force `norm` is within [`EstimatorConfig::near_g`] of g: what a still
+/// torso with any chip's offsets reads.
+fn near_g(config: &EstimatorConfig, norm: f32) -> bool {
+    (norm / GRAVITY_M_S2 - 1.0).abs() <= config.near_g
+}
+
 /// Pitch and roll of the body whose "up" is `up` (unit). Pitch as `atan2`, not `asin`: the
 /// kinematics already link `atan2` into the image, and it needs no clamp.
 fn attitude_of(up: [f32; 3]) -> Attitude {
@@ -466,31 +479,6 @@ fn attitude_of(up: [f32; 3]) -> Attitude {
         pitch_rad: atan2(-x, sqrt(y * y + z * z)),
         roll_rad: atan2(y, z),
     }
-}
-
-fn dot(a: [f32; 3], b: [f32; 3]) -> f32 {
-    let ([ax, ay, az], [bx, by, bz]) = (a, b);
-    ax * bx + ay * by + az * bz
-}
-
-fn cross(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
-    let ([ax, ay, az], [bx, by, bz]) = (a, b);
-    [ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx]
-}
-
-fn scale(a: [f32; 3], k: f32) -> [f32; 3] {
-    a.map(|x| x * k)
-}
-
-fn zip3(a: [f32; 3], b: [f32; 3], f: impl Fn(f32, f32) -> f32) -> [f32; 3] {
-    let ([a0, a1, a2], [b0, b1, b2]) = (a, b);
-    [f(a0, b0), f(a1, b1), f(a2, b2)]
-}
-
-/// `a` scaled to unit length; `None` for a zero or non-finite vector.
-fn normalise(a: [f32; 3]) -> Option<[f32; 3]> {
-    let norm = sqrt(dot(a, a));
-    (norm.is_finite() && norm > 1e-6).then(|| scale(a, 1.0 / norm))
 }
 
 #[cfg(test)]

@@ -13,6 +13,7 @@ use super::*;
 use std::println;
 
 const RATE: TickRate = TickRate::SIM_250_HZ;
+const CONFIG: EstimatorConfig = EstimatorConfig::ROBOT;
 const HZ: u32 = 250;
 /// On the legs, no known acceleration.
 const STILL: Motion = Motion {
@@ -68,7 +69,7 @@ struct Rig {
 impl Rig {
     fn new(bias: [f32; 3]) -> Self {
         Self {
-            estimator: AttitudeEstimator::new(EstimatorConfig::ROBOT, RATE),
+            estimator: AttitudeEstimator::new(&CONFIG, RATE),
             tick: 0,
             noise: Noise(0x9E37_79B9_7F4A_7C15),
             bias,
@@ -85,7 +86,8 @@ impl Rig {
         );
         let force = zip3(scale(up, GRAVITY_M_S2), extra_body_force, |a, b| a + b);
         let accel = zip3(force, self.noise.vec(ACCEL_STD), |a, b| a + b);
-        self.estimator.update(Tick(self.tick), gyro, accel, STILL);
+        self.estimator
+            .update(&CONFIG, Tick(self.tick), gyro, accel, STILL);
         self.tick += 1;
     }
 
@@ -112,22 +114,29 @@ fn pitch_and_roll_follow_from_up() {
 
 #[test]
 fn nothing_before_a_sample_and_a_first_sample_not_near_g_or_turning_is_no_start() {
-    let mut e = AttitudeEstimator::new(EstimatorConfig::ROBOT, RATE);
+    let mut e = AttitudeEstimator::new(&CONFIG, RATE);
     assert!(!e.started());
-    assert!(!e.update(Tick(0), [0.0; 3], [0.0, 0.0, 3.0], STILL));
+    assert!(!e.update(&CONFIG, Tick(0), [0.0; 3], [0.0, 0.0, 3.0], STILL));
     assert!(!e.update(
+        &CONFIG,
         Tick(1),
         [f32::NAN, 0.0, 0.0],
         [0.0, 0.0, GRAVITY_M_S2],
         STILL
     ));
     // A fall: near g, but turning fast.
-    assert!(!e.update(Tick(1), [0.0, 2.0, 0.0], [0.0, 0.0, GRAVITY_M_S2], STILL));
+    assert!(!e.update(
+        &CONFIG,
+        Tick(1),
+        [0.0, 2.0, 0.0],
+        [0.0, 0.0, GRAVITY_M_S2],
+        STILL
+    ));
     assert!(!e.started());
-    assert!(e.update(Tick(2), [0.0; 3], [0.0, 0.1, GRAVITY_M_S2], STILL));
+    assert!(e.update(&CONFIG, Tick(2), [0.0; 3], [0.0, 0.1, GRAVITY_M_S2], STILL));
     assert!(e.started());
     assert!(
-        !e.update(Tick(2), [0.0; 3], [0.0, 0.0, GRAVITY_M_S2], STILL),
+        !e.update(&CONFIG, Tick(2), [0.0; 3], [0.0, 0.0, GRAVITY_M_S2], STILL),
         "same tick"
     );
 }
@@ -162,6 +171,7 @@ fn a_calibrated_filter_knocked_10_degrees_off_converges_within_1_degree_in_8_s()
     for _ in 0..25 {
         // 1.745 rad/s for 0.1 s reported, the torso still.
         rig.estimator.update(
+            &CONFIG,
             Tick(rig.tick),
             [0.0, 1.745, 0.0],
             scale(up_of(0.0, 0.0), GRAVITY_M_S2),
@@ -226,7 +236,7 @@ fn accelerated(accel: f32, seconds: f32, told: bool) -> (f32, f32) {
         );
         let accel_m_s2 = zip3(force, rig.noise.vec(ACCEL_STD), |a, b| a + b);
         rig.estimator
-            .update(Tick(rig.tick), gyro, accel_m_s2, motion);
+            .update(&CONFIG, Tick(rig.tick), gyro, accel_m_s2, motion);
         rig.tick += 1;
         worst = worst.max(rig.error_deg(0.0, 0.0));
     }
@@ -319,7 +329,8 @@ fn on_the_wheels_the_known_acceleration_is_taken_out() {
                 ground_accel_m_s2: if told { ground } else { 0.0 },
             };
             let gyro = [0.0, rate, 0.0];
-            rig.estimator.update(Tick(rig.tick), gyro, force, motion);
+            rig.estimator
+                .update(&CONFIG, Tick(rig.tick), gyro, force, motion);
             rig.tick += 1;
             worst = worst.max(rig.error_deg(pitch, 0.0));
         }
