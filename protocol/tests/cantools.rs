@@ -44,6 +44,7 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
             }
         }
         AnyMessage::WheelCommand(m) => {
+            put("enable".into(), f64::from(m.enable.raw()), 1.0);
             for (name, t) in WHEEL_NAMES.iter().zip(m.torque) {
                 put(format!("torque_{name}"), f64::from(t.si()), Torque::STEP);
             }

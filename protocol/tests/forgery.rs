@@ -111,6 +111,7 @@ fn the_forger_computes_the_crc_right_a_crc_frame_it_forges_passes() {
     // So do the drive commands, which carry a CRC (a CMAC is too dear for the drives at 1 kHz):
     // a forger on the bus can command the drives, though not replay the controller's frames.
     let command = AnyMessage::WheelCommand(WheelCommand {
+        enable: DriveEnable::Enabled,
         torque: [Torque::from_raw(-2500).unwrap(); 2],
     });
     let fake = forged(&command, common::EPOCH, 5);

@@ -14,6 +14,7 @@ fn the_sender_counts_per_identifier_from_the_session_time() {
     let mut tx = Sender::new();
     let counter = |frame: Frame| decode_frame(frame.id(), frame.data()).unwrap().counter;
     let wheel = AnyMessage::WheelCommand(WheelCommand {
+        enable: DriveEnable::Enabled,
         torque: [Torque::default(); 2],
     });
     let legs = AnyMessage::LegTargets(LegTargets {

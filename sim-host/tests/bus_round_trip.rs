@@ -122,6 +122,7 @@ impl TestController {
                 position: self.targets_rad.map(Angle::saturating_from_si),
             }));
             let wheels = self.seal(AnyMessage::WheelCommand(WheelCommand {
+                enable: DriveEnable::Enabled,
                 torque: self.wheel_torque_nm.map(Torque::saturating_from_si),
             }));
             for frame in [legs, wheels] {

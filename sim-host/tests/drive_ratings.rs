@@ -28,6 +28,7 @@ fn a_wheel_command_above_the_rating_is_applied_at_the_rating_and_counted() {
     drive.on_frame(0, &announce());
     let command = |torque_nm: [f32; 2], counter: u32| {
         AnyMessage::WheelCommand(WheelCommand {
+            enable: DriveEnable::Enabled,
             torque: torque_nm.map(Torque::saturating_from_si),
         })
         .encode(&SESSION, counter)

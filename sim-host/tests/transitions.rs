@@ -115,7 +115,7 @@ fn the_fold_right_after_a_trot_happens_in_place() {
         let before = [(0.0, TeleopMode::Stop), (0.1, trot)];
         assert_in_place(
             &transition(what, &before, TeleopMode::Fold, 4.0),
-            0.06,
+            0.05,
             tilt_deg,
         );
     }

@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use crate::setup::MCU_TARGET;
-use crate::util::{cargo, root, run as sh};
+use crate::util::{cargo, run as sh};
 
 /// The image's budgets, bytes.
 const FLASH_BUDGET: u64 = 64 * 1024;
@@ -50,8 +50,7 @@ pub fn run() -> Result<(), String> {
 
 /// Where cargo puts an MCU binary of this profile.
 pub fn image(name: &str) -> PathBuf {
-    root()
-        .join("target")
+    crate::util::target_dir()
         .join(MCU_TARGET)
         .join(PROFILE)
         .join(name)

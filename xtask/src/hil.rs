@@ -77,7 +77,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
             sh(Command::new(binary)
                 .args(filter.iter())
                 .args(["--test-threads", "2", "--show-output"])
-                .env("HIL_BIN_DIR", root().join("target").join("release"))
+                .env("HIL_BIN_DIR", crate::util::target_dir().join("release"))
                 .env("HIL_EXPORT_DIR", &export)
                 .env("HIL_SPEED_GOAL", goal))?;
         }
@@ -290,7 +290,7 @@ fn initramfs(
     for tool in TOOLS {
         copy_with_libraries(&dir, &which(tool)?)?;
     }
-    let release = root().join("target").join("release");
+    let release = crate::util::target_dir().join("release");
     for program in ["sim-host", "firmware-host", "teleop"] {
         copy_with_libraries(&dir, &release.join(program))?;
     }

@@ -283,7 +283,13 @@ impl Node {
             self.push(&mut frames, &message);
         }
         if due(MessageId::WheelCommand) {
+            // The wheel drive is enabled with the legs: both go torque-free together.
             let message = AnyMessage::WheelCommand(WheelCommand {
+                enable: if output.legs_enabled {
+                    DriveEnable::Enabled
+                } else {
+                    DriveEnable::Disabled
+                },
                 torque: output.wheel_torque_nm.map(Torque::saturating_from_si),
             });
             self.push(&mut frames, &message);
@@ -323,6 +329,7 @@ impl Node {
         });
         self.push(&mut frames, &legs);
         let wheels = AnyMessage::WheelCommand(WheelCommand {
+            enable: DriveEnable::Disabled,
             torque: [Torque::saturating_from_si(0.0); 2],
         });
         self.push(&mut frames, &wheels);

@@ -203,6 +203,7 @@ impl Bus {
         self.send(
             Controller,
             AnyMessage::WheelCommand(WheelCommand {
+                enable: DriveEnable::Enabled,
                 torque: [Torque::from_raw(small(t)).unwrap(); 2],
             }),
         );

@@ -23,6 +23,7 @@ pub fn check_failed(frame: &Frame) -> DecodeError {
 
 pub fn wheel_command(counter: u32, epoch: Epoch) -> Frame {
     AnyMessage::WheelCommand(WheelCommand {
+        enable: DriveEnable::Enabled,
         torque: [Torque::from_raw(counter as i16).unwrap(); 2],
     })
     .encode(&Session::owned(TEST_KEY, epoch), counter)
@@ -41,6 +42,7 @@ pub fn heartbeat(ms: u32) -> AnyMessage {
 
 pub fn wheel_message(ms: u32) -> AnyMessage {
     AnyMessage::WheelCommand(WheelCommand {
+        enable: DriveEnable::Enabled,
         torque: [Torque::from_raw((ms % 1000) as i16).unwrap(); 2],
     })
 }

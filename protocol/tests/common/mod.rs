@@ -63,8 +63,8 @@ pub fn any_message() -> impl Strategy<Value = AnyMessage> {
                 position: position.into()
             })
         ),
-        proptest::array::uniform2(torque())
-            .prop_map(|torque| AnyMessage::WheelCommand(WheelCommand { torque })),
+        (pick(DriveEnable::ALL), proptest::array::uniform2(torque()))
+            .prop_map(|(enable, torque)| AnyMessage::WheelCommand(WheelCommand { enable, torque })),
         (
             pick(&Leg::ALL),
             proptest::array::uniform4(angle()),

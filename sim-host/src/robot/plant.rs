@@ -72,10 +72,8 @@ impl Default for Plant {
     /// The tested default: the IMU is a real chip ([`ChipSpec::BMI088`]), the part drawn with
     /// seed 1 — the same chip as `sim-host run`'s default `--seed 1` (see `docs/simulator.md`
     /// for what other draws do to the acceptance figures) — and rated drives
-    /// ([`DriveRatings::RATED`]) that measure with real encoders ([`DriveSensing::REAL`]). No
-    /// transport delay yet: with a cycle of delay the drives hear an E-stop latch a cycle late
-    /// (their own cut then comes after the deadline; the wheel command has no torque-off to send
-    /// earlier).
+    /// ([`DriveRatings::RATED`]) that measure with real encoders ([`DriveSensing::REAL`]), on a
+    /// bus that holds every frame back a cycle each way (a real CAN loop's transport delay).
     fn default() -> Self {
         Self {
             imu: ImuModel::Chip(ChipSpec::BMI088),
@@ -85,7 +83,7 @@ impl Default for Plant {
             },
             drives: DriveRatings::RATED,
             sensing: DriveSensing::REAL,
-            transport_delay_cycles: 0,
+            transport_delay_cycles: 1,
             variation: Variation::NOMINAL,
         }
     }

@@ -8,7 +8,7 @@
 //! ([`WheelDrive::clamped`]); at speed and when hot the motors give less
 //! ([`Rating::WHEEL`]), and the next status says so ([`protocol::DriveFlags::SATURATED`]).
 
-use protocol::{AnyMessage, Frame, MessageId, Torque, WheelFeedback, WheelVelocity};
+use protocol::{AnyMessage, DriveEnable, Frame, MessageId, Torque, WheelFeedback, WheelVelocity};
 
 use crate::robot::drive_core::{Authority, DriveCore};
 use crate::robot::physics::Physics;
@@ -86,7 +86,8 @@ impl WheelDrive {
             let wanted = command.torque.map(|t| f64::from(t.si()));
             self.torque_nm = wanted.map(|t| t.clamp(-WHEEL_PEAK_TORQUE_NM, WHEEL_PEAK_TORQUE_NM));
             self.clamped += u64::from(self.torque_nm != wanted);
-            self.core.set_commanded_enable(true);
+            self.core
+                .set_commanded_enable(command.enable == DriveEnable::Enabled);
         }
     }
 

@@ -199,9 +199,10 @@ mod tests {
     use super::*;
 
     fn wheel_command(left: i16, right: i16) -> Vec<u8> {
-        use protocol::{AnyMessage, Torque, WheelCommand};
+        use protocol::{AnyMessage, DriveEnable, Torque, WheelCommand};
         let torque = [left, right].map(|raw| Torque::from_raw(raw).unwrap());
-        AnyMessage::WheelCommand(WheelCommand { torque })
+        let enable = DriveEnable::Enabled;
+        AnyMessage::WheelCommand(WheelCommand { enable, torque })
             .encode(&pil_session(), 3)
             .unwrap()
             .data()
