@@ -28,7 +28,7 @@ struct Figures {
     balancing: bool,
 }
 
-/// Folds, waits `settle_s`, then rests 30 s.
+/// Folds, waits `settle_s`, then rests 30 s, the torso's centre of mass `offset_m` forward.
 fn rest(offset_m: f64, settle_s: f64) -> Figures {
     let plant = Plant {
         variation: Variation {
@@ -37,6 +37,11 @@ fn rest(offset_m: f64, settle_s: f64) -> Figures {
         },
         ..Plant::default()
     };
+    rest_on(plant, offset_m, settle_s)
+}
+
+/// Folds `plant`'s robot, waits `settle_s`, then rests 30 s.
+fn rest_on(plant: Plant, offset_m: f64, settle_s: f64) -> Figures {
     let plan = vec![PlanStep::at(0.0, TeleopMode::Fold)];
     let (faults, model) = (Faults::default(), Path::new(DEFAULT_MODEL));
     let mut rig = Rig::with_plant(model, plan, &faults, &faults, plant).unwrap();
@@ -78,5 +83,17 @@ fn a_centre_of_mass_off_the_drawing_is_learned_and_the_robot_stays_put() {
                 "{f:?}"
             );
         }
+    }
+}
+
+#[test]
+fn an_imu_mounted_5_degrees_off_is_learned_and_the_robot_stays_put() {
+    for mount_deg in [-5.0_f64, 5.0] {
+        let mut plant = Plant::default();
+        plant.imu_noise.mount_pitch_rad = mount_deg.to_radians();
+        let f = rest_on(plant, 0.0, 10.0);
+        println!("MEASURED resting with the IMU mounted {mount_deg:+}° in pitch: {f:?}");
+        assert!(f.balancing, "{f:?}");
+        assert!(f.drift_m < 0.05, "{f:?}");
     }
 }

@@ -36,6 +36,10 @@ pub struct ImuNoise {
     pub accel_std_m_s2: f64,
     /// Constant accelerometer bias, x y z, m/s².
     pub accel_bias_m_s2: [f64; 3],
+    /// The chip mounted pitched by this against the torso, rad (about the torso's y axis): a
+    /// board or bracket off its drawing; the chip measures the torso's rate and specific force
+    /// in its own, rotated axes.
+    pub mount_pitch_rad: f64,
     /// Seed of the noise generator and of the chip's biases and noise, so that runs repeat
     /// exactly.
     pub seed: u64,
@@ -96,7 +100,8 @@ impl ImuNode {
     pub fn sample(&mut self, now_us: u64, physics: &Physics) -> AnyMessage {
         let (_, gyro, accel) = physics.imu();
         let n = self.noise;
-        let mut rate = gyro;
+        let mut rate = pitched(gyro, n.mount_pitch_rad);
+        let accel = pitched(accel, n.mount_pitch_rad);
         for (value, bias) in rate.iter_mut().zip(n.gyro_bias_rad_s) {
             *value += bias + self.gaussian(n.gyro_std_rad_s);
         }
@@ -113,4 +118,13 @@ impl ImuNode {
             acceleration: force.map(|a| Acceleration::saturating_from_si(a as f32)),
         })
     }
+}
+
+/// `v` (torso axes) in the axes of a chip pitched by `pitch_rad` about y.
+fn pitched(v: [f64; 3], pitch_rad: f64) -> [f64; 3] {
+    if pitch_rad == 0.0 {
+        return v;
+    }
+    let (sin, cos) = pitch_rad.sin_cos();
+    [cos * v[0] - sin * v[2], v[1], sin * v[0] + cos * v[2]]
 }
