@@ -215,7 +215,8 @@ mod tests {
         let mut check = Check::default();
         let same = wheel_command(100, 200);
         compare_frame(5, id, &same, &same, &mut check).unwrap();
-        assert_eq!((check.values, check.off_by_one), (2, 0));
+        // Three values: the enable and the two torques.
+        assert_eq!((check.values, check.off_by_one), (3, 0));
         compare_frame(6, id, &same, &wheel_command(100, 201), &mut check).unwrap();
         assert_eq!(check.off_by_one, 1);
         assert!(
