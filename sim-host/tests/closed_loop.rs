@@ -2,61 +2,20 @@
 //! frames on the in-process bus, in lockstep — does every mode of the report, measured from the
 //! simulator's ground truth. Lockstep is deterministic, so these figures repeat exactly.
 
-use std::path::{Path, PathBuf};
-use std::time::Duration;
+mod common;
 
+use common::{config, plan, scenario_file, segments_of};
 use sim_host::output::metrics::SegmentSummary;
-use sim_host::robot::model::DEFAULT_MODEL;
 use sim_host::robot::plant::Plant;
-use sim_host::session::{self, BusChoice, Clock, SegmentSpec, SessionConfig};
-use teleop_core::scenario::{mode_name, Scenario};
+use sim_host::session::{self, SegmentSpec};
+use teleop_core::scenario::Scenario;
 use teleop_core::scripted::PlanStep;
-
-fn scenario_file(name: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../scenarios/acceptance")
-        .join(name)
-}
-
-fn config(plan: Vec<PlanStep>, segments: Vec<SegmentSpec>, duration_s: f64) -> SessionConfig {
-    SessionConfig {
-        attach: None,
-        faults: Default::default(),
-        model: PathBuf::from(DEFAULT_MODEL),
-        bus: BusChoice::Inproc,
-        clock: Clock::Lockstep,
-        duration_s,
-        control_hz: 250,
-        reply_timeout: Duration::from_millis(100),
-        max_speed: None,
-        plant: Plant::default(),
-        teleop_plan: plan,
-        out_dir: None,
-        plots: false,
-        progress: false,
-        stop: None,
-        segments,
-        frames: None,
-        viewer: false,
-    }
-}
-
-fn segments_of(scenario: &Scenario) -> Vec<SegmentSpec> {
-    scenario
-        .steps
-        .iter()
-        .map(|s| SegmentSpec {
-            start_s: s.plan.at_us as f64 * 1e-6,
-            label: s.label.clone(),
-            mode: mode_name(s.plan.mode),
-        })
-        .collect()
-}
 
 /// Runs an acceptance scenario; returns its segments, checking the bus stayed clean.
 fn run(name: &str) -> Vec<SegmentSummary> {
     let scenario = Scenario::load(&scenario_file(name)).unwrap();
     let report = session::run(&config(
+        Plant::default(),
         scenario.plan(),
         segments_of(&scenario),
         scenario.duration_s,
@@ -66,27 +25,6 @@ fn run(name: &str) -> Vec<SegmentSummary> {
     assert_eq!(report.firmware_rejected, Some(0));
     assert_eq!(report.drives_rejected, 0);
     report.segments
-}
-
-fn plan(steps: &[(f64, &str)]) -> (Vec<PlanStep>, Vec<SegmentSpec>) {
-    let plan: Vec<PlanStep> = steps
-        .iter()
-        .map(|(at_s, mode)| PlanStep {
-            at_us: (at_s * 1e6) as u64,
-            mode: teleop_core::scenario::parse_mode(mode).unwrap(),
-            body_height_m: 0.0,
-            speed_scale_pct: 100.0,
-        })
-        .collect();
-    let segments = steps
-        .iter()
-        .map(|(at_s, mode)| SegmentSpec {
-            start_s: *at_s,
-            label: (*mode).to_owned(),
-            mode: (*mode).to_owned(),
-        })
-        .collect();
-    (plan, segments)
 }
 
 fn assert_wheels_only(s: &SegmentSummary) {
@@ -184,7 +122,7 @@ fn x_from_every_mode_stops_within_1_s_and_stays_upright() {
             "fold"
         };
         let (plan, segments) = plan(&[(0.0, start), (3.0, mode), (6.0, "X")]);
-        let report = session::run(&config(plan, segments, 9.0)).unwrap();
+        let report = session::run(&config(Plant::default(), plan, segments, 9.0)).unwrap();
         let x = &report.segments[2];
         println!(
             "{mode} → X: moved {:.3} m after the first second, within 3 cm after {:?} s, tilt {:.1}°",
@@ -216,7 +154,7 @@ fn every_ordered_pair_of_modes_switched_mid_motion_keeps_the_robot_up_and_in_lim
                 continue;
             }
             let (plan, segments) = plan(&[(0.0, "X"), (0.5, first), (3.5, second)]);
-            let report = session::run(&config(plan, segments, 7.0)).unwrap();
+            let report = session::run(&config(Plant::default(), plan, segments, 7.0)).unwrap();
             for s in &report.segments {
                 let bad = s.fell
                     || s.joint_limit_violations > 0
@@ -262,7 +200,7 @@ fn ten_minutes_of_trotting_behave_like_the_first_ten_seconds() {
         segment(13.0, "middle"),
         segment(591.0, "last 10 s"),
     ];
-    let report = session::run(&config(plan, segments, 601.0)).unwrap();
+    let report = session::run(&config(Plant::default(), plan, segments, 601.0)).unwrap();
     assert_eq!(report.stats.missed_cycles, 0);
     let (first, middle, last) = (
         &report.segments[1],
@@ -300,7 +238,7 @@ fn body_height_commands_are_held_within_1_cm_where_the_legs_reach() {
             body_height_m: offset_m,
             speed_scale_pct: 100.0,
         }];
-        let report = session::run(&config(plan, Vec::new(), 3.0)).unwrap();
+        let report = session::run(&config(Plant::default(), plan, Vec::new(), 3.0)).unwrap();
         let s = &report.segments[0];
         assert!(!s.fell && s.joint_limit_violations == 0, "{s:#?}");
         s.end_height_m

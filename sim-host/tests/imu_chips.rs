@@ -8,16 +8,15 @@
 //! cargo test --release -p sim-host --test imu_chips -- --ignored --nocapture
 //! ```
 
-use std::path::{Path, PathBuf};
-use std::time::Duration;
+mod common;
 
+use common::{config, plan, scenario_file, segments_of};
 use sim_host::output::metrics::SegmentSummary;
 use sim_host::robot::imu::{ImuModel, ImuNoise};
 use sim_host::robot::imu_chip::{ChipSpec, ImuChip};
-use sim_host::robot::model::DEFAULT_MODEL;
 use sim_host::robot::plant::Plant;
-use sim_host::session::{self, BusChoice, Clock, SegmentSpec, SessionConfig};
-use teleop_core::scenario::{mode_name, parse_mode, Scenario};
+use sim_host::session::{self, SegmentSpec};
+use teleop_core::scenario::Scenario;
 use teleop_core::scripted::PlanStep;
 
 /// The default plant with the BMI088 drawn from `seed`.
@@ -38,44 +37,15 @@ fn run(
     segments: Vec<SegmentSpec>,
     duration_s: f64,
 ) -> Vec<SegmentSummary> {
-    let report = session::run(&SessionConfig {
-        attach: None,
-        faults: Default::default(),
-        model: PathBuf::from(DEFAULT_MODEL),
-        bus: BusChoice::Inproc,
-        clock: Clock::Lockstep,
-        duration_s,
-        control_hz: 250,
-        reply_timeout: Duration::from_millis(100),
-        max_speed: None,
-        plant,
-        teleop_plan: plan,
-        out_dir: None,
-        plots: false,
-        progress: false,
-        stop: None,
-        segments,
-        frames: None,
-        viewer: false,
-    })
-    .unwrap();
+    let report = session::run(&config(plant, plan, segments, duration_s)).unwrap();
     assert_eq!(report.stats.missed_cycles, 0);
     report.segments
 }
 
 /// The W segment of the `w.toml` acceptance run.
 fn w(plant: Plant) -> SegmentSummary {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenarios/acceptance/w.toml");
-    let scenario = Scenario::load(&path).unwrap();
-    let segments = scenario
-        .steps
-        .iter()
-        .map(|s| SegmentSpec {
-            start_s: s.plan.at_us as f64 * 1e-6,
-            label: s.label.clone(),
-            mode: mode_name(s.plan.mode),
-        })
-        .collect();
+    let scenario = Scenario::load(&scenario_file("w.toml")).unwrap();
+    let segments = segments_of(&scenario);
     run(plant, scenario.plan(), segments, scenario.duration_s).remove(1)
 }
 
@@ -83,23 +53,7 @@ fn w(plant: Plant) -> SegmentSummary {
 /// test; 12: after 8 s at rest on the wheels, in which the balance law learns its trim).
 fn stop_after_w(plant: Plant, w_s: f64) -> SegmentSummary {
     let steps = [(0.0, "fold"), (w_s, "W"), (w_s + 3.0, "X")];
-    let plan = steps
-        .iter()
-        .map(|(at_s, mode)| PlanStep {
-            at_us: (at_s * 1e6) as u64,
-            mode: parse_mode(mode).unwrap(),
-            body_height_m: 0.0,
-            speed_scale_pct: 100.0,
-        })
-        .collect();
-    let segments = steps
-        .iter()
-        .map(|(at_s, mode)| SegmentSpec {
-            start_s: *at_s,
-            label: (*mode).to_owned(),
-            mode: (*mode).to_owned(),
-        })
-        .collect();
+    let (plan, segments) = plan(&steps);
     run(plant, plan, segments, w_s + 6.0).remove(2)
 }
 

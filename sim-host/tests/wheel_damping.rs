@@ -22,36 +22,6 @@ const WHEEL_RADIUS_M: f64 = 0.12;
 /// The wheel axle below the torso's origin, torso frame, m (the model's wheel bodies).
 const AXLE_IN_TORSO_M: [f64; 3] = [0.0, 0.0, -0.15];
 
-/// `v` rotated by the unit quaternion `q` (w x y z).
-fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
-    let [w, x, y, z] = q;
-    let u = [x, y, z];
-    let cross = |a: [f64; 3], b: [f64; 3]| {
-        [
-            a[1] * b[2] - a[2] * b[1],
-            a[2] * b[0] - a[0] * b[2],
-            a[0] * b[1] - a[1] * b[0],
-        ]
-    };
-    let t = cross(u, v).map(|c| 2.0 * c);
-    let ut = cross(u, t);
-    [0, 1, 2].map(|i| v[i] + w * t[i] + ut[i])
-}
-
-/// World velocity of the wheel axle's midpoint, m/s: the torso's velocity plus its rotation
-/// about the torso's origin (MuJoCo's free-joint angular velocity is in the body frame).
-fn axle_velocity_m_s(torso: &sim_host::robot::physics::TorsoState) -> [f64; 3] {
-    let q = torso.quat_wxyz;
-    let omega = rotate(q, torso.ang_vel_rad_s);
-    let r = rotate(q, AXLE_IN_TORSO_M);
-    let spin = [
-        omega[1] * r[2] - omega[2] * r[1],
-        omega[2] * r[0] - omega[0] * r[2],
-        omega[0] * r[1] - omega[1] * r[0],
-    ];
-    [0, 1, 2].map(|i| torso.vel_m_s[i] + spin[i])
-}
-
 /// What one fold did.
 #[derive(Debug)]
 struct Figures {
@@ -98,7 +68,7 @@ fn fold_with(damping: f64) -> Figures {
         if airborne_seen && f.slip_at_touchdown_rad_s.is_none() && on_ground.iter().all(|&t| t) {
             let torso = physics.torso();
             let pitch_rate = torso.ang_vel_rad_s[1];
-            let axle_rate = axle_velocity_m_s(&torso)[0] / WHEEL_RADIUS_M;
+            let axle_rate = torso.point_velocity_m_s(AXLE_IN_TORSO_M)[0] / WHEEL_RADIUS_M;
             let joint = physics.wheel_velocities_rad_s();
             f.slip_at_touchdown_rad_s = Some(joint.map(|w| w + pitch_rate - axle_rate));
         }

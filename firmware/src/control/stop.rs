@@ -32,16 +32,17 @@
 //! 4. **Off** — legs disabled, wheel torque 0.
 //!
 //! On the **legs** (standing, trotting, standing up) the legs ramp straight from where they are
-//! into the kickstand pose, over all the time the deadline leaves: this sits the torso down onto
-//! its wheels and front feet; then Settle and Off.
+//! into the kickstand pose, which sits the torso down onto its wheels and front feet; then
+//! Settle and Off. The first share of that path ([`StopConfig::sit_rise_share`]) lifts the torso
+//! a little rather than lowering it, so it goes at the fastest rate (**Rise**) and the rest of
+//! the deadline goes to the part that lowers it (the torso's fastest descent from a stand was
+//! 0.34 m/s over one ramp; see `sim-host/tests/estop_ss1.rs` for the present figures).
 //!
 //! The front feet pass under the hips on the way to their stops. From the wheels they are
 //! unloaded and swing out sideways on the way ([`StopConfig::kickstand_spread_rad`]), so they
-//! barely touch the ground; from the legs they carry the robot and stay in their plane. There
-//! the sit-down still drops the torso at up to 0.58 m/s (from a stand; 0.25 m/s from a trot):
-//! the legs cannot put the feet under the hips lower than 2 cm above the wheels' reach, so the
-//! torso's last centimetres onto the wheels come as the front feet sweep forward. Folding in
-//! place first (as the wheels do) is the way out, with the gentler fold still to come.
+//! barely touch the ground; from the legs they carry the robot and stay in their plane, and
+//! the torso's last centimetres onto the wheels come as the front feet sweep forward and leave
+//! the ground for a moment.
 //!
 //! Why a kickstand: unpowered on its wheels with the legs folded, the robot rolls back 26° onto
 //! its leg links (its centre of mass sits just behind the axle), and limp legs cannot carry it
@@ -102,6 +103,10 @@ pub struct StopConfig {
     /// instead, so the sweep no longer lifts the robot off its wheels and drops it (torso
     /// descent under power 1.17 m/s without, 0.31 m/s with 0.6 rad, in the simulator).
     pub kickstand_spread_rad: f32,
+    /// Share of the joint path into the kickstand that a sit-down from the legs takes first, at
+    /// [`StopConfig::kickstand_rate_rad_s`]: over it the torso does not come down (from a
+    /// stand it rises 2 cm), so the rest of the deadline goes to the part that lowers it.
+    pub sit_rise_share: f32,
     /// Damping the wheels hold still with in a stop against an obstacle, N·m per rad/s of
     /// wheel rate (the per-wheel torque limit clamps it).
     pub wheel_hold_nm_per_rad_s: f32,
@@ -121,6 +126,7 @@ impl StopConfig {
         settle_ms: 100,
         cut_margin_ms: 12,
         kickstand_spread_rad: deg_to_rad(34.0),
+        sit_rise_share: 0.3,
         wheel_hold_nm_per_rad_s: 10.0,
         kickstand_front: LegJoints {
             hip_abduction_rad: 0.0,
@@ -248,6 +254,9 @@ enum Phase {
     /// On the wheels: braking to rest, balancing, legs ramping into the fold (they are there
     /// unless the latch came mid-fold).
     Brake(Ramp),
+    /// From the legs: the first share of the way into the kickstand
+    /// ([`StopConfig::sit_rise_share`]), which does not lower the torso, at the fastest rate.
+    Rise(Ramp),
     /// Legs ramping into the kickstand pose, balancing while the wheels are on the ground.
     Kickstand(Ramp),
     /// The last pose reached at this tick and held until the settle time has passed.
@@ -327,9 +336,15 @@ impl Stop {
                     rate,
                 ))
             }
-            // Slowly as the deadline allows: the descent of the torso scales with it.
-            // No spread: the front feet carry the robot until the wheels take it.
-            Carrier::Legs => Phase::Kickstand(kickstand_ramp(&config, rate, legs_rad, now, 0, 0.0)),
+            Carrier::Legs => {
+                let share = config.sit_rise_share.clamp(0.0, 1.0);
+                let mut to = legs_rad;
+                for (joint, goal) in to.iter_mut().zip(config.kickstand().iter()) {
+                    *joint += share * (goal - *joint);
+                }
+                let peak_rate = config.kickstand_rate_rad_s;
+                Phase::Rise(Ramp::new(legs_rad, to, now, peak_rate, rate))
+            }
         };
         // The fastest kickstand from the fold, settled, with one tick to spare: what the
         // braking must leave before the cut.
@@ -385,6 +400,23 @@ impl Stop {
                         now,
                         elapsed,
                         spread,
+                    ))
+                });
+                (StopCommand::Servo(pose), next)
+            }
+            Phase::Rise(ramp) => {
+                let (pose, done) = ramp.at(now);
+                let elapsed = now.since(self.latched);
+                // Slowly as the deadline allows: the descent of the torso scales with it.
+                // No spread: the front feet carry the robot until the wheels take it.
+                let next = done.then(|| {
+                    Phase::Kickstand(kickstand_ramp(
+                        &self.config,
+                        self.rate,
+                        pose,
+                        now,
+                        elapsed,
+                        0.0,
                     ))
                 });
                 (StopCommand::Servo(pose), next)

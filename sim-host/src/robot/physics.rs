@@ -41,6 +41,30 @@ impl TorsoState {
         let up_z = 1.0 - 2.0 * (x * x + y * y);
         up_z.clamp(-1.0, 1.0).acos()
     }
+
+    /// `v_torso`, a vector in the torso frame, in the world frame.
+    pub fn to_world(&self, v_torso: [f64; 3]) -> [f64; 3] {
+        let [w, x, y, z] = self.quat_wxyz;
+        let u = [x, y, z];
+        let t = cross(u, v_torso).map(|c| 2.0 * c);
+        let ut = cross(u, t);
+        [0, 1, 2].map(|i| v_torso[i] + w * t[i] + ut[i])
+    }
+
+    /// World velocity of the point `offset_m` from the torso's origin (torso frame), m/s: the
+    /// torso's velocity plus its rotation about its origin.
+    pub fn point_velocity_m_s(&self, offset_m: [f64; 3]) -> [f64; 3] {
+        let spin = cross(self.to_world(self.ang_vel_rad_s), self.to_world(offset_m));
+        [0, 1, 2].map(|i| self.vel_m_s[i] + spin[i])
+    }
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 
 /// What touches the ground (any geom outside the robot's subtree).

@@ -1,0 +1,84 @@
+//! What the closed-loop session tests share: a lockstep in-process session on a given plant,
+//! and a plan of operator modes with one measured segment per step.
+#![allow(dead_code)] // each test file uses a part
+
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::robot::plant::Plant;
+use sim_host::session::{BusChoice, Clock, SegmentSpec, SessionConfig};
+use teleop_core::scenario::{mode_name, parse_mode, Scenario};
+use teleop_core::scripted::PlanStep;
+
+/// An acceptance scenario file by name.
+pub fn scenario_file(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenarios/acceptance")
+        .join(name)
+}
+
+/// A lockstep session on the in-process bus at 250 Hz, no output files.
+pub fn config(
+    plant: Plant,
+    plan: Vec<PlanStep>,
+    segments: Vec<SegmentSpec>,
+    duration_s: f64,
+) -> SessionConfig {
+    SessionConfig {
+        attach: None,
+        faults: Default::default(),
+        model: PathBuf::from(DEFAULT_MODEL),
+        bus: BusChoice::Inproc,
+        clock: Clock::Lockstep,
+        duration_s,
+        control_hz: 250,
+        reply_timeout: Duration::from_millis(100),
+        max_speed: None,
+        plant,
+        teleop_plan: plan,
+        out_dir: None,
+        plots: false,
+        progress: false,
+        stop: None,
+        segments,
+        frames: None,
+        viewer: false,
+    }
+}
+
+/// One measured segment per step of `scenario`, labelled as the scenario labels it.
+pub fn segments_of(scenario: &Scenario) -> Vec<SegmentSpec> {
+    scenario
+        .steps
+        .iter()
+        .map(|s| SegmentSpec {
+            start_s: s.plan.at_us as f64 * 1e-6,
+            label: s.label.clone(),
+            mode: mode_name(s.plan.mode),
+        })
+        .collect()
+}
+
+/// A plan of `(start s, mode key)` steps at full speed and height, and one segment per step
+/// labelled with its mode.
+pub fn plan(steps: &[(f64, &str)]) -> (Vec<PlanStep>, Vec<SegmentSpec>) {
+    let plan = steps
+        .iter()
+        .map(|(at_s, mode)| PlanStep {
+            at_us: (at_s * 1e6) as u64,
+            mode: parse_mode(mode).unwrap(),
+            body_height_m: 0.0,
+            speed_scale_pct: 100.0,
+        })
+        .collect();
+    let segments = steps
+        .iter()
+        .map(|(at_s, mode)| SegmentSpec {
+            start_s: *at_s,
+            label: (*mode).to_owned(),
+            mode: (*mode).to_owned(),
+        })
+        .collect();
+    (plan, segments)
+}
