@@ -1,0 +1,296 @@
+//! One trial's plant, drawn from its seed alone: the body (masses, centre of mass, friction,
+//! wheel damping), the IMU's bias and noise, the transport delay each way and the drives'
+//! torque ratings. The ranges are the robustness issue's; [`PARAMETERS`] lists them with the
+//! end of each range that is hard on the controller, for the table's "most extreme parameter".
+//!
+//! The generator is SplitMix64, written out here rather than taken from `rand`: a seed then
+//! draws the same plant on every machine and with every version of every dependency, which
+//! is the contract of `--seed` (a trial is reproducible from its seed alone).
+
+use host_can::fault_plan::{FaultPlan, Faults};
+use serde::{Deserialize, Serialize};
+
+use crate::robot::plant::{DriveRatings, Plant};
+use crate::robot::rating::Rating;
+use crate::robot::variation::Variation;
+
+/// SplitMix64 (Steele, Lea, Flood 2014): 64 bits of state, every seed a good stream.
+#[derive(Debug, Clone)]
+pub struct Draw {
+    state: u64,
+}
+
+impl Draw {
+    /// The stream of `seed`.
+    pub fn new(seed: u64) -> Self {
+        Self { state: seed }
+    }
+
+    /// The next 64 random bits.
+    pub fn next_u64(&mut self) -> u64 {
+        self.state = self.state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [0, 1) (53 bits).
+    pub fn unit(&mut self) -> f64 {
+        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
+    }
+}
+
+/// How a parameter's value is drawn from a uniform `u` in [0, 1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Scale {
+    /// `lo + u·(hi − lo)`.
+    Linear,
+    /// `lo·(hi/lo)^u`: every decade as likely (a range over two decades).
+    Log,
+    /// One of the whole numbers `lo…hi`, each as likely.
+    Integer,
+}
+
+/// Which end of a parameter's range is hard on the controller.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Harsh {
+    /// Both ends (a centre of mass off either way): harshness `|2u − 1|`.
+    BothEnds,
+    /// The low end (weaker drives): harshness `1 − u`.
+    Low,
+    /// The high end (heavier legs, more delay): harshness `u`.
+    High,
+}
+
+/// One drawn parameter of the plant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Parameter {
+    /// Name in the JSON results and the table.
+    pub name: &'static str,
+    /// Lowest and highest value.
+    pub range: (f64, f64),
+    /// Unit, for the table.
+    pub unit: &'static str,
+    /// How it is drawn.
+    pub scale: Scale,
+    /// Its hard end.
+    pub harsh: Harsh,
+}
+
+impl Parameter {
+    const fn new(
+        name: &'static str,
+        range: (f64, f64),
+        unit: &'static str,
+        scale: Scale,
+        harsh: Harsh,
+    ) -> Self {
+        Self {
+            name,
+            range,
+            unit,
+            scale,
+            harsh,
+        }
+    }
+
+    /// The value of a uniform draw `u`.
+    pub fn value(&self, u: f64) -> f64 {
+        let (lo, hi) = self.range;
+        match self.scale {
+            Scale::Linear => lo + u * (hi - lo),
+            Scale::Log => lo * (hi / lo).powf(u),
+            Scale::Integer => (lo + (u * (hi - lo + 1.0)).floor()).min(hi),
+        }
+    }
+
+    /// How close a draw `u` lies to the hard end, 0 (mildest) … 1 (hardest).
+    pub fn harshness(&self, u: f64) -> f64 {
+        match self.harsh {
+            Harsh::BothEnds => (2.0 * u - 1.0).abs(),
+            Harsh::Low => 1.0 - u,
+            Harsh::High => u,
+        }
+    }
+}
+
+/// Every drawn parameter, in draw order (changing the order changes every trial's plant).
+/// The IMU's are [`crate::campaign::imu::PARAMETERS`]'s, drawn last.
+pub const BODY: [Parameter; 10] = [
+    Parameter::new("mass", (0.9, 1.1), "×", Scale::Linear, Harsh::BothEnds),
+    Parameter::new("com_x", (-0.02, 0.02), "m", Scale::Linear, Harsh::BothEnds),
+    Parameter::new("com_y", (-0.02, 0.02), "m", Scale::Linear, Harsh::BothEnds),
+    Parameter::new("leg_mass", (1.0, 3.0), "×", Scale::Linear, Harsh::High),
+    Parameter::new("friction", (0.6, 1.2), "", Scale::Linear, Harsh::Low),
+    // The controller feeds forward the model's 2 N·m·s/rad: the low end is the far one.
+    Parameter::new(
+        "wheel_damping",
+        (0.02, 2.0),
+        "N·m·s/rad",
+        Scale::Log,
+        Harsh::Low,
+    ),
+    Parameter::new(
+        "delay_tx",
+        (0.0, 2.0),
+        "cycles",
+        Scale::Integer,
+        Harsh::High,
+    ),
+    Parameter::new(
+        "delay_rx",
+        (0.0, 2.0),
+        "cycles",
+        Scale::Integer,
+        Harsh::High,
+    ),
+    Parameter::new("leg_rating", (0.8, 1.0), "×", Scale::Linear, Harsh::Low),
+    Parameter::new("wheel_rating", (0.8, 1.0), "×", Scale::Linear, Harsh::Low),
+];
+
+/// Every parameter, body then IMU: the columns of a trial's draw.
+pub fn parameters() -> impl Iterator<Item = &'static Parameter> {
+    BODY.iter().chain(crate::campaign::imu::PARAMETERS.iter())
+}
+
+/// One trial's draw: per parameter of [`parameters`], the uniform `u` it came from.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Draws {
+    /// The seed.
+    pub seed: u64,
+    /// `u` per parameter, in [`parameters`] order.
+    pub unit: Vec<f64>,
+}
+
+impl Draws {
+    /// The draw of `seed`.
+    pub fn of(seed: u64) -> Self {
+        let mut draw = Draw::new(seed);
+        Self {
+            seed,
+            unit: parameters().map(|_| draw.unit()).collect(),
+        }
+    }
+
+    /// Parameter `name`'s value (0 for a name not drawn: a bug the tests catch).
+    pub fn value(&self, name: &str) -> f64 {
+        parameters()
+            .zip(&self.unit)
+            .find(|(p, _)| p.name == name)
+            .map_or(0.0, |(p, u)| p.value(*u))
+    }
+
+    /// The parameter nearest its hard end, its value and harshness.
+    pub fn most_extreme(&self) -> (&'static Parameter, f64, f64) {
+        let mut best = (&BODY[0], self.value(BODY[0].name), -1.0);
+        for (p, u) in parameters().zip(&self.unit) {
+            let h = p.harshness(*u);
+            if h > best.2 {
+                best = (p, p.value(*u), h);
+            }
+        }
+        best
+    }
+
+    /// The plant these draws describe, on `drives` with their torques scaled.
+    pub fn plant(&self, drives: DriveRatings) -> Plant {
+        Plant {
+            imu_noise: crate::campaign::imu::noise(self),
+            drives: DriveRatings {
+                leg_joint: scaled(drives.leg_joint, self.value("leg_rating")),
+                wheel: scaled(drives.wheel, self.value("wheel_rating")),
+            },
+            variation: Variation {
+                mass_scale: self.value("mass"),
+                leg_mass_scale: self.value("leg_mass"),
+                torso_com_offset_m: [self.value("com_x"), self.value("com_y"), 0.0],
+                friction: Some(self.value("friction")),
+                wheel_damping_nm_s_rad: Some(self.value("wheel_damping")),
+            },
+        }
+    }
+
+    /// The simulator's bus connection: feedback (`tx`) and commands (`rx`) late by the drawn
+    /// whole cycles.
+    pub fn faults(&self) -> Faults {
+        let cycles = |name| self.value(name) as u32;
+        Faults {
+            tx: FaultPlan {
+                delay_cycles: cycles("delay_tx"),
+                ..FaultPlan::default()
+            },
+            rx: FaultPlan {
+                delay_cycles: cycles("delay_rx"),
+                ..FaultPlan::default()
+            },
+            seed: self.seed,
+        }
+    }
+}
+
+/// `rating` with its peak and continuous torques times `scale` (speeds and heating as rated).
+pub fn scaled(rating: Rating, scale: f64) -> Rating {
+    Rating {
+        peak_torque_nm: rating.peak_torque_nm * scale,
+        continuous_torque_nm: rating.continuous_torque_nm * scale,
+        ..rating
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn splitmix_repeats_its_published_stream() {
+        // The first outputs for seed 0 (the reference implementation's test vector).
+        let mut draw = Draw::new(0);
+        assert_eq!(draw.next_u64(), 0xE220_A839_7B1D_CDAF);
+        assert_eq!(draw.next_u64(), 0x6E78_9E6A_A1B9_65F4);
+    }
+
+    #[test]
+    fn every_value_lies_in_its_range_and_a_seed_draws_the_same_plant() {
+        for seed in 0..200 {
+            let draws = Draws::of(seed);
+            assert_eq!(draws, Draws::of(seed));
+            for (p, u) in parameters().zip(&draws.unit) {
+                let v = p.value(*u);
+                assert!(
+                    (p.range.0..=p.range.1).contains(&v),
+                    "{}: {v} outside {:?}",
+                    p.name,
+                    p.range
+                );
+                assert!((0.0..=1.0).contains(&p.harshness(*u)));
+            }
+        }
+        assert_ne!(Draws::of(1), Draws::of(2));
+    }
+
+    #[test]
+    fn integers_take_each_value_and_harshness_points_to_the_hard_end() {
+        let delay = BODY[6];
+        assert_eq!(delay.value(0.0), 0.0);
+        assert_eq!(delay.value(0.5), 1.0);
+        assert_eq!(delay.value(0.999), 2.0);
+        let damping = BODY[5];
+        assert!((damping.value(0.5) - 0.2).abs() < 1e-12);
+        assert_eq!(damping.harshness(0.0), 1.0);
+        assert_eq!(BODY[1].harshness(0.5), 0.0);
+    }
+
+    #[test]
+    fn the_plant_carries_the_draws() {
+        let draws = Draws::of(7);
+        let plant = draws.plant(DriveRatings::RATED);
+        let scale = draws.value("leg_rating");
+        assert!((plant.drives.leg_joint.peak_torque_nm - 33.5 * scale).abs() < 1e-9);
+        assert_eq!(plant.variation.mass_scale, draws.value("mass"));
+        assert_eq!(
+            draws.faults().tx.delay_cycles,
+            draws.value("delay_tx") as u32
+        );
+    }
+}

@@ -1,0 +1,103 @@
+//! Runs on every core: a pool of worker threads, each taking the next run off a shared counter
+//! (long and short runs balance themselves), each run its own MuJoCo instance. Results come
+//! back in the order of the runs given, whatever the number of workers or which finished
+//! first: the pool changes how fast, never what.
+
+use std::path::Path;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
+
+use indicatif::{ProgressBar, ProgressStyle};
+
+use crate::campaign::scenario::Scenario;
+use crate::campaign::{run_one, Drives, RunResult};
+
+/// The workers' count when none is asked for: one per core.
+pub fn default_jobs() -> usize {
+    std::thread::available_parallelism().map_or(1, usize::from)
+}
+
+/// Runs `runs` (seed, scenario) on `jobs` workers (at least one); a progress bar on stderr
+/// when `progress` (indicatif hides it where stderr is no terminal). Returns the results in
+/// the order of `runs` and the wall time taken.
+pub fn run_all(
+    model: &Path,
+    drives: Drives,
+    runs: &[(u64, Scenario)],
+    jobs: usize,
+    progress: bool,
+) -> (Vec<RunResult>, Duration) {
+    let bar = if progress {
+        ProgressBar::new(runs.len() as u64)
+    } else {
+        ProgressBar::hidden()
+    };
+    if let Ok(style) = ProgressStyle::with_template(
+        "{elapsed_precise} [{bar:40}] {pos}/{len} runs ({per_sec}, {eta} left) {msg}",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    let next = AtomicUsize::new(0);
+    let failures = AtomicUsize::new(0);
+    let done: Mutex<Vec<(usize, RunResult)>> = Mutex::new(Vec::with_capacity(runs.len()));
+    let started = Instant::now();
+    std::thread::scope(|scope| {
+        for _ in 0..jobs.clamp(1, runs.len().max(1)) {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                let Some(&(seed, scenario)) = runs.get(i) else {
+                    break;
+                };
+                let result = run_one(model, drives, seed, scenario);
+                if !result.verdict.outcome.success() {
+                    let n = failures.fetch_add(1, Ordering::Relaxed) + 1;
+                    bar.set_message(format!("{n} failed"));
+                    tracing::debug!(seed, %scenario, verdict = ?result.verdict, "run failed");
+                }
+                done.lock()
+                    .unwrap_or_else(|poisoned| poisoned.into_inner())
+                    .push((i, result));
+                bar.inc(1);
+            });
+        }
+    });
+    let elapsed = started.elapsed();
+    bar.finish_and_clear();
+    let mut done = done.into_inner().unwrap_or_else(|p| p.into_inner());
+    done.sort_by_key(|(i, _)| *i);
+    (done.into_iter().map(|(_, r)| r).collect(), elapsed)
+}
+
+/// The pool's speed-up on this machine: `runs` with 1 worker, then with 2, in one process.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scaling {
+    /// Runs measured (each count ran them all).
+    pub runs: usize,
+    /// Runs per second with one worker.
+    pub one_per_s: f64,
+    /// Runs per second with two workers.
+    pub two_per_s: f64,
+    /// Whether both gave the same results (they must).
+    pub same_results: bool,
+}
+
+impl Scaling {
+    /// Two workers' rate over one's.
+    pub fn ratio(&self) -> f64 {
+        self.two_per_s / self.one_per_s
+    }
+}
+
+/// Measures [`Scaling`] on `runs`.
+pub fn scaling(model: &Path, drives: Drives, runs: &[(u64, Scenario)]) -> Scaling {
+    let (one, t1) = run_all(model, drives, runs, 1, false);
+    let (two, t2) = run_all(model, drives, runs, 2, false);
+    let rate = |t: Duration| runs.len() as f64 / t.as_secs_f64().max(1e-9);
+    Scaling {
+        runs: runs.len(),
+        one_per_s: rate(t1),
+        two_per_s: rate(t2),
+        same_results: one == two,
+    }
+}
