@@ -9,7 +9,7 @@ use std::path::Path;
 
 use host_can::fault_plan::Faults;
 use sim_host::campaign::judge::{judge, Outcome};
-use sim_host::campaign::pool::run_all;
+use sim_host::campaign::pool::run_campaign;
 use sim_host::campaign::results::{merge, Campaign, Results, Shard};
 use sim_host::campaign::scenario::{Scenario, ESTOP_AT_S};
 use sim_host::campaign::{observe, table, Drives};
@@ -48,7 +48,7 @@ fn small() -> Campaign {
 
 fn run(campaign: &Campaign, shard: Shard, jobs: usize) -> Results {
     let model = Path::new(DEFAULT_MODEL);
-    let (runs, _) = run_all(model, campaign.drives, &campaign.runs(shard), jobs, false);
+    let (runs, _) = run_campaign(model, campaign.drives, &campaign.runs(shard), jobs, false);
     Results::new(campaign.clone(), shard, runs)
 }
 

@@ -195,37 +195,52 @@ impl Draws {
 
     /// The plant these draws describe, on `drives` with their torques scaled.
     pub fn plant(&self, drives: DriveRatings) -> Plant {
-        Plant {
-            imu_noise: crate::campaign::imu::noise(self),
-            drives: DriveRatings {
-                leg_joint: scaled(drives.leg_joint, self.value("leg_rating")),
-                wheel: scaled(drives.wheel, self.value("wheel_rating")),
-            },
-            variation: Variation {
-                mass_scale: self.value("mass"),
-                leg_mass_scale: self.value("leg_mass"),
-                torso_com_offset_m: [self.value("com_x"), self.value("com_y"), 0.0],
-                friction: Some(self.value("friction")),
-                wheel_damping_nm_s_rad: Some(self.value("wheel_damping")),
-            },
-        }
+        plant_of(&|name| Some(self.value(name)), self.seed, drives)
     }
 
     /// The simulator's bus connection: feedback (`tx`) and commands (`rx`) late by the drawn
     /// whole cycles.
     pub fn faults(&self) -> Faults {
-        let cycles = |name| self.value(name) as u32;
-        Faults {
-            tx: FaultPlan {
-                delay_cycles: cycles("delay_tx"),
-                ..FaultPlan::default()
-            },
-            rx: FaultPlan {
-                delay_cycles: cycles("delay_rx"),
-                ..FaultPlan::default()
-            },
-            seed: self.seed,
-        }
+        faults_of(&|name| Some(self.value(name)), self.seed)
+    }
+}
+
+/// Parameter values by name: `Some` where set, `None` where the robot is as modelled.
+pub type Values<'a> = &'a dyn Fn(&str) -> Option<f64>;
+
+/// The plant with the parameters `value` sets, the rest as modelled, on `drives`; `seed`
+/// seeds the IMU's noise.
+pub fn plant_of(value: Values<'_>, seed: u64, drives: DriveRatings) -> Plant {
+    let or = |name, nominal| value(name).unwrap_or(nominal);
+    Plant {
+        imu_noise: crate::campaign::imu::noise(value, seed),
+        drives: DriveRatings {
+            leg_joint: scaled(drives.leg_joint, or("leg_rating", 1.0)),
+            wheel: scaled(drives.wheel, or("wheel_rating", 1.0)),
+        },
+        variation: Variation {
+            mass_scale: or("mass", 1.0),
+            leg_mass_scale: or("leg_mass", 1.0),
+            torso_com_offset_m: [or("com_x", 0.0), or("com_y", 0.0), 0.0],
+            friction: value("friction"),
+            wheel_damping_nm_s_rad: value("wheel_damping"),
+        },
+    }
+}
+
+/// The simulator's bus connection with the delays `value` sets (none where unset).
+pub fn faults_of(value: Values<'_>, seed: u64) -> Faults {
+    let cycles = |name| value(name).unwrap_or(0.0) as u32;
+    Faults {
+        tx: FaultPlan {
+            delay_cycles: cycles("delay_tx"),
+            ..FaultPlan::default()
+        },
+        rx: FaultPlan {
+            delay_cycles: cycles("delay_rx"),
+            ..FaultPlan::default()
+        },
+        seed,
     }
 }
 

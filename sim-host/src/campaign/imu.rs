@@ -22,7 +22,7 @@
 //!   does not compute; it is drawn up to the tilt the accelerometer's noise alone makes
 //!   (accelerometer noise over g), the error of an attitude taken from the accelerometer.
 
-use crate::campaign::draw::{Draws, Harsh, Parameter, Scale};
+use crate::campaign::draw::{Harsh, Parameter, Scale, Values};
 use crate::robot::imu::ImuNoise;
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
@@ -69,16 +69,18 @@ const fn white(name: &'static str, max: f64, unit: &'static str) -> Parameter {
     }
 }
 
-/// The IMU noise of a trial's draws (its generator seeded by the trial's seed).
-pub fn noise(draws: &Draws) -> ImuNoise {
-    let axes = |prefix: &str| ["x", "y", "z"].map(|axis| draws.value(&format!("{prefix}_{axis}")));
+/// The IMU noise with the parameters `value` sets (an ideal sensor where unset), its
+/// generator seeded by `seed`.
+pub fn noise(value: Values<'_>, seed: u64) -> ImuNoise {
+    let or_zero = |name: &str| value(name).unwrap_or(0.0);
+    let axes = |prefix: &str| ["x", "y", "z"].map(|axis| or_zero(&format!("{prefix}_{axis}")));
     ImuNoise {
-        gyro_std_rad_s: draws.value("gyro_noise"),
+        gyro_std_rad_s: or_zero("gyro_noise"),
         gyro_bias_rad_s: axes("gyro_bias"),
-        accel_std_m_s2: draws.value("accel_noise"),
+        accel_std_m_s2: or_zero("accel_noise"),
         accel_bias_m_s2: axes("accel_bias"),
-        orientation_std_rad: draws.value("orientation_noise"),
-        seed: draws.seed,
+        orientation_std_rad: or_zero("orientation_noise"),
+        seed,
     }
 }
 
@@ -122,8 +124,8 @@ mod tests {
 
     #[test]
     fn the_noise_carries_the_draws() {
-        let draws = Draws::of(3);
-        let n = noise(&draws);
+        let draws = crate::campaign::draw::Draws::of(3);
+        let n = noise(&|name| Some(draws.value(name)), draws.seed);
         assert_eq!(n.gyro_bias_rad_s[1], draws.value("gyro_bias_y"));
         assert_eq!(n.accel_std_m_s2, draws.value("accel_noise"));
         assert_eq!(n.seed, 3);

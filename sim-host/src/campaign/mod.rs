@@ -6,7 +6,8 @@
 //! - [`draw`]: a trial's plant from its seed (body, delays, drive ratings), [`imu`]: its IMU;
 //! - [`scenario`]: the scenarios' plans; [`observe`]: one run on the rig; [`judge`]: its verdict;
 //! - [`pool`]: runs on every core; [`results`]: the JSON file, shards and their merge;
-//!   [`table`]: the Markdown table of `docs/campaign.md`; [`error`]: why a campaign failed.
+//!   [`table`]: the Markdown table of `docs/campaign.md`; [`sweep`]: one parameter at a time;
+//!   [`error`]: why a campaign failed.
 //!
 //! A trial is one seed: its plant runs every scenario, each run its own MuJoCo instance. The
 //! seed alone fixes the run (lockstep, seeded noise and delays), so results do not depend on
@@ -21,6 +22,7 @@ pub mod observe;
 pub mod pool;
 pub mod results;
 pub mod scenario;
+pub mod sweep;
 pub mod table;
 
 use std::path::Path;
@@ -84,21 +86,25 @@ pub struct RunResult {
 /// closed loop becomes the run's verdict, so one bad run does not stop a campaign.
 pub fn run_one(model: &Path, drives: Drives, seed: u64, scenario: Scenario) -> RunResult {
     let draws = Draws::of(seed);
-    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        observe_one(model, drives, &draws, scenario)
-    }));
-    let verdict = match outcome {
-        Ok(Ok(obs)) => judge::judge(scenario, &obs),
-        Ok(Err(e)) => failed(Outcome::Error, "the closed loop ran", e.to_string()),
-        Err(panic) => failed(Outcome::Panic, "no panic", panic_text(panic.as_ref())),
-    };
     RunResult {
         seed,
         scenario,
-        verdict,
+        verdict: judged(scenario, || observe_one(model, drives, &draws, scenario)),
         plant: draw::parameters()
             .map(|p| (p.name.to_owned(), draws.value(p.name)))
             .collect(),
+    }
+}
+
+/// The verdict of the run `observe` makes; its panic or error is the verdict.
+pub fn judged(
+    scenario: Scenario,
+    observe: impl FnOnce() -> Result<Observation, crate::session::SessionError>,
+) -> Verdict {
+    match std::panic::catch_unwind(std::panic::AssertUnwindSafe(observe)) {
+        Ok(Ok(obs)) => judge::judge(scenario, &obs),
+        Ok(Err(e)) => failed(Outcome::Error, "the closed loop ran", e.to_string()),
+        Err(panic) => failed(Outcome::Panic, "no panic", panic_text(panic.as_ref())),
     }
 }
 

@@ -18,46 +18,40 @@ pub fn default_jobs() -> usize {
     std::thread::available_parallelism().map_or(1, usize::from)
 }
 
-/// Runs `runs` (seed, scenario) on `jobs` workers (at least one); a progress bar on stderr
-/// when `progress` (indicatif hides it where stderr is no terminal). Returns the results in
-/// the order of `runs` and the wall time taken.
-pub fn run_all(
-    model: &Path,
-    drives: Drives,
-    runs: &[(u64, Scenario)],
+/// Runs `work` on each of `items` on `jobs` workers (at least one); a progress bar on stderr
+/// when `progress` (indicatif hides it where stderr is no terminal), counting the results
+/// `failed` says failed. Returns the results in the order of `items` and the wall time taken.
+pub fn run_all<J, R>(
+    items: &[J],
     jobs: usize,
     progress: bool,
-) -> (Vec<RunResult>, Duration) {
-    let bar = if progress {
-        ProgressBar::new(runs.len() as u64)
-    } else {
-        ProgressBar::hidden()
-    };
-    if let Ok(style) = ProgressStyle::with_template(
-        "{elapsed_precise} [{bar:40}] {pos}/{len} runs ({per_sec}, {eta} left) {msg}",
-    ) {
-        bar.set_style(style.progress_chars("=> "));
-    }
+    work: impl Fn(&J) -> R + Sync,
+    failed: impl Fn(&R) -> bool + Sync,
+) -> (Vec<R>, Duration)
+where
+    J: Sync,
+    R: Send,
+{
+    let bar = progress_bar(items.len(), progress);
     let next = AtomicUsize::new(0);
     let failures = AtomicUsize::new(0);
-    let done: Mutex<Vec<(usize, RunResult)>> = Mutex::new(Vec::with_capacity(runs.len()));
+    let done: Mutex<Vec<(usize, R)>> = Mutex::new(Vec::with_capacity(items.len()));
     let started = Instant::now();
     std::thread::scope(|scope| {
-        for _ in 0..jobs.clamp(1, runs.len().max(1)) {
+        for _ in 0..jobs.clamp(1, items.len().max(1)) {
             scope.spawn(|| loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some(&(seed, scenario)) = runs.get(i) else {
+                let index = next.fetch_add(1, Ordering::Relaxed);
+                let Some(item) = items.get(index) else {
                     break;
                 };
-                let result = run_one(model, drives, seed, scenario);
-                if !result.verdict.outcome.success() {
+                let result = work(item);
+                if failed(&result) {
                     let n = failures.fetch_add(1, Ordering::Relaxed) + 1;
                     bar.set_message(format!("{n} failed"));
-                    tracing::debug!(seed, %scenario, verdict = ?result.verdict, "run failed");
                 }
                 done.lock()
                     .unwrap_or_else(|poisoned| poisoned.into_inner())
-                    .push((i, result));
+                    .push((index, result));
                 bar.inc(1);
             });
         }
@@ -67,6 +61,37 @@ pub fn run_all(
     let mut done = done.into_inner().unwrap_or_else(|p| p.into_inner());
     done.sort_by_key(|(i, _)| *i);
     (done.into_iter().map(|(_, r)| r).collect(), elapsed)
+}
+
+fn progress_bar(len: usize, progress: bool) -> ProgressBar {
+    let bar = if progress {
+        ProgressBar::new(len as u64)
+    } else {
+        ProgressBar::hidden()
+    };
+    if let Ok(style) = ProgressStyle::with_template(
+        "{elapsed_precise} [{bar:40}] {pos}/{len} runs ({per_sec}, {eta} left) {msg}",
+    ) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
+
+/// The campaign's runs (seed, scenario) of a plant drawn around `drives`, on `jobs` workers.
+pub fn run_campaign(
+    model: &Path,
+    drives: Drives,
+    runs: &[(u64, Scenario)],
+    jobs: usize,
+    progress: bool,
+) -> (Vec<RunResult>, Duration) {
+    run_all(
+        runs,
+        jobs,
+        progress,
+        |&(seed, scenario)| run_one(model, drives, seed, scenario),
+        |r| !r.verdict.outcome.success(),
+    )
 }
 
 /// The pool's speed-up on this machine: `runs` with 1 worker, then with 2, in one process.
@@ -91,8 +116,8 @@ impl Scaling {
 
 /// Measures [`Scaling`] on `runs`.
 pub fn scaling(model: &Path, drives: Drives, runs: &[(u64, Scenario)]) -> Scaling {
-    let (one, t1) = run_all(model, drives, runs, 1, false);
-    let (two, t2) = run_all(model, drives, runs, 2, false);
+    let (one, t1) = run_campaign(model, drives, runs, 1, false);
+    let (two, t2) = run_campaign(model, drives, runs, 2, false);
     let rate = |t: Duration| runs.len() as f64 / t.as_secs_f64().max(1e-9);
     Scaling {
         runs: runs.len(),

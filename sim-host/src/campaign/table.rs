@@ -155,8 +155,8 @@ fn worst(results: &Results) -> String {
     text
 }
 
-/// Three significant figures.
-fn significant(value: f64) -> String {
+/// A value to three decimals, or in scientific notation when small or large.
+pub fn significant(value: f64) -> String {
     if value == 0.0 || (0.01..1000.0).contains(&value.abs()) {
         format!("{value:.3}")
             .trim_end_matches('0')

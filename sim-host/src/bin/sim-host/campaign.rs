@@ -8,7 +8,7 @@ use sim_host::campaign::draw::{parameters, Draws};
 use sim_host::campaign::pool::{self, default_jobs};
 use sim_host::campaign::results::{self, Campaign, Results, Shard};
 use sim_host::campaign::scenario::Scenario;
-use sim_host::campaign::{judge, table, CampaignError, Drives};
+use sim_host::campaign::{judge, sweep, table, CampaignError, Drives};
 use sim_host::robot::model::DEFAULT_MODEL;
 
 use crate::run::DrivesArg;
@@ -39,6 +39,10 @@ pub(crate) struct CampaignArgs {
     /// prints runs per second and the ratio (runs no campaign).
     #[arg(long, value_name = "N")]
     pub(crate) scaling: Option<usize>,
+    /// One parameter at a time instead: the robot as modelled, then each parameter alone at
+    /// each end of its range, through the scenarios; prints a table of the verdicts.
+    #[arg(long, conflicts_with_all = ["seed", "shard", "merge", "scaling"])]
+    pub(crate) sweep: bool,
     /// The drives whose torque ratings are drawn down to −20 %: `rated` (real parts) or
     /// `ideal` (unlimited leg servos, flat 30 N·m wheels).
     #[arg(long, value_enum, default_value_t = DrivesArg::Rated)]
@@ -84,6 +88,23 @@ pub(crate) fn run(args: CampaignArgs) -> Result<(), CampaignError> {
     if let Some(n) = args.scaling {
         return scaling(&args, &campaign, n);
     }
+    if args.sweep {
+        check_setup(&args)?;
+        let jobs = args.jobs.unwrap_or_else(default_jobs);
+        let runs = sweep::run(
+            &args.model,
+            campaign.drives,
+            &campaign.scenarios,
+            jobs,
+            !args.no_progress,
+        );
+        print!(
+            "One parameter at a time on {} drives:\n\n{}",
+            campaign.drives.name(),
+            sweep::markdown(&runs, &campaign.scenarios)
+        );
+        return Ok(());
+    }
     let results = if args.merge.is_empty() {
         run_campaign(&args, campaign)?
     } else {
@@ -108,7 +129,7 @@ fn run_campaign(args: &CampaignArgs, campaign: Campaign) -> Result<Results, Camp
     let jobs = args.jobs.unwrap_or_else(default_jobs);
     tracing::info!(runs = runs.len(), jobs, %shard, drives = campaign.drives.name(), "campaign");
     let (done, elapsed) =
-        pool::run_all(&args.model, campaign.drives, &runs, jobs, !args.no_progress);
+        pool::run_campaign(&args.model, campaign.drives, &runs, jobs, !args.no_progress);
     let ok = done.iter().filter(|r| r.verdict.outcome.success()).count();
     tracing::info!(
         "{ok} of {} runs succeeded; {:.1} s wall, {:.2} runs/s on {jobs} workers",
