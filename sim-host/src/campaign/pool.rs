@@ -105,6 +105,9 @@ pub struct Scaling {
     pub two_per_s: f64,
     /// Whether both gave the same results (they must).
     pub same_results: bool,
+    /// CPU seconds this process got per wall second with one worker and with two (Linux;
+    /// `None` elsewhere): below 2 with two workers, other processes had the cores.
+    pub cpu_per_wall: Option<[f64; 2]>,
 }
 
 impl Scaling {
@@ -116,13 +119,31 @@ impl Scaling {
 
 /// Measures [`Scaling`] on `runs`.
 pub fn scaling(model: &Path, drives: Drives, runs: &[(u64, Scenario)]) -> Scaling {
+    let c0 = cpu_seconds();
     let (one, t1) = run_campaign(model, drives, runs, 1, false);
+    let c1 = cpu_seconds();
     let (two, t2) = run_campaign(model, drives, runs, 2, false);
+    let c2 = cpu_seconds();
     let rate = |t: Duration| runs.len() as f64 / t.as_secs_f64().max(1e-9);
+    let per_wall = |a: Option<f64>, b: Option<f64>, t: Duration| Some((b? - a?) / t.as_secs_f64());
     Scaling {
         runs: runs.len(),
         one_per_s: rate(t1),
         two_per_s: rate(t2),
         same_results: one == two,
+        cpu_per_wall: per_wall(c0, c1, t1)
+            .zip(per_wall(c1, c2, t2))
+            .map(|(a, b)| [a, b]),
     }
+}
+
+/// CPU time (user and system) this process has used, s, from `/proc/self/stat` (fields 14
+/// and 15, in the kernel's 100 Hz user ticks); `None` where there is no such file.
+fn cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // The command name (field 2) is in parentheses and may hold spaces: count after it.
+    let rest = stat.rsplit_once(')')?.1;
+    let fields: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = |i: usize| fields.get(i)?.parse::<f64>().ok();
+    Some((ticks(11)? + ticks(12)?) / 100.0)
 }

@@ -13,6 +13,7 @@ use crate::campaign::draw::{faults_of, parameters, plant_of, Parameter};
 use crate::campaign::judge::{Outcome, Verdict};
 use crate::campaign::pool::run_all;
 use crate::campaign::scenario::Scenario;
+use crate::campaign::table::{significant, with_unit};
 use crate::campaign::{judged, Drives};
 
 /// One setting: the robot as modelled, or one parameter at one end.
@@ -48,13 +49,10 @@ impl Setting {
         match self.parameter {
             None => "as modelled".into(),
             Some(p) => format!(
-                "{} = {} {}",
+                "{} = {}",
                 p.name,
-                crate::campaign::table::significant(self.value),
-                p.unit
-            )
-            .trim_end()
-            .to_owned(),
+                with_unit(&significant(self.value), p.unit)
+            ),
         }
     }
 

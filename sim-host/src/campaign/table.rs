@@ -138,15 +138,14 @@ fn worst(results: &Results) -> String {
         let (p, value, harsh) = Draws::of(r.seed).most_extreme();
         let _ = writeln!(
             text,
-            "| {} | {} | {} | {}: {} | {} = {} {} ({:.0} % to its hard end) | `{}` |",
+            "| {} | {} | {} | {}: {} | {} = {} ({:.0} % to its hard end) | `{}` |",
             r.seed,
             r.scenario,
             r.verdict.outcome.name(),
             r.verdict.check,
             r.verdict.detail.replace('|', "/"),
             p.name,
-            significant(value),
-            p.unit,
+            with_unit(&significant(value), p.unit),
             100.0 * harsh,
             rerun_command(r.seed, r.scenario, results.campaign.drives),
         );
@@ -164,6 +163,15 @@ pub fn significant(value: f64) -> String {
             .to_owned()
     } else {
         format!("{value:.2e}")
+    }
+}
+
+/// `text unit`, or `text` for a parameter without a unit.
+pub fn with_unit(text: &str, unit: &str) -> String {
+    if unit.is_empty() {
+        text.to_owned()
+    } else {
+        format!("{text} {unit}")
     }
 }
 
@@ -191,11 +199,12 @@ fn by_parameter(runs: &[RunResult]) -> String {
         let [a, b, c] = bins.map(|(bad, all)| percent(bad, all));
         let _ = writeln!(
             text,
-            "| {} | {} … {} {} | {a} | {b} | {c} |",
+            "| {} | {} | {a} | {b} | {c} |",
             p.name,
-            significant(p.range.0),
-            significant(p.range.1),
-            p.unit
+            with_unit(
+                &format!("{} … {}", significant(p.range.0), significant(p.range.1)),
+                p.unit
+            ),
         );
     }
     text

@@ -172,6 +172,13 @@ fn scaling(args: &CampaignArgs, campaign: &Campaign, n: usize) -> Result<(), Cam
         s.ratio(),
         if s.same_results { "yes" } else { "NO" }
     );
+    if let Some([one, two]) = s.cpu_per_wall {
+        println!(
+            "CPU seconds per wall second: {one:.2} with 1 worker, {two:.2} with 2 ({} cores; \
+             below 2 with 2 workers, other processes had the cores)",
+            default_jobs()
+        );
+    }
     Ok(())
 }
 
