@@ -173,10 +173,15 @@ fn scaling(args: &CampaignArgs, campaign: &Campaign, n: usize) -> Result<(), Cam
         if s.same_results { "yes" } else { "NO" }
     );
     if let Some([one, two]) = s.cpu_per_wall {
+        // Runs per CPU second: equal for both counts when the pool adds no work of its own,
+        // whatever share of the cores the other processes left.
         println!(
             "CPU seconds per wall second: {one:.2} with 1 worker, {two:.2} with 2 ({} cores; \
-             below 2 with 2 workers, other processes had the cores)",
-            default_jobs()
+             below 2 with 2 workers, other processes had the cores); runs per CPU second: \
+             {:.1} with 1 worker, {:.1} with 2",
+            default_jobs(),
+            s.one_per_s / one.max(1e-9),
+            s.two_per_s / two.max(1e-9),
         );
     }
     Ok(())
