@@ -144,15 +144,20 @@ pub fn judge(scenario: Scenario, obs: &Observation) -> Verdict {
         };
     };
     let excused = obs.abort.is_some() && failed.iter().all(|c| c.excusable);
+    // After an abort, the check that decided a miss is one the abort does not excuse.
+    let decisive = match obs.abort {
+        Some(_) => failed.iter().find(|c| !c.excusable).unwrap_or(first),
+        None => first,
+    };
     Verdict {
         outcome: if excused {
             Outcome::Aborted
         } else {
             Outcome::Missed
         },
-        check: first.name.into(),
-        detail: format!("{}{}", first.detail, abort_note(obs)),
-        shortfall: first.shortfall,
+        check: decisive.name.into(),
+        detail: format!("{}{}", decisive.detail, abort_note(obs)),
+        shortfall: decisive.shortfall,
     }
 }
 
@@ -338,4 +343,69 @@ fn estop(obs: &Observation) -> Vec<Check> {
         )),
         strict(at_most("tilt at the end", f.final_tilt_deg, 20.0, "°")),
     ]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::campaign::observe::{Abort, JointExcess, StopFigures};
+    use protocol::FaultFlags;
+
+    fn stopped(off_after_s: f64, speed_m_s: f64, abort: bool) -> Observation {
+        Observation {
+            segments: Vec::new(),
+            fell_at_s: None,
+            abort: abort.then_some(Abort {
+                at_s: 5.0,
+                flags: FaultFlags::WHEEL_STALL,
+            }),
+            balancing_at_s: Some(1.0),
+            final_state: None,
+            stop: Some(StopFigures {
+                speed_at_latch_m_s: speed_m_s,
+                rest_after_s: Some(0.5),
+                off_after_s: Some(off_after_s),
+                reported: true,
+                held: true,
+                ..StopFigures::default()
+            }),
+            missed_cycles: 0,
+            joint_limits: JointExcess::default(),
+            joint_limits_torque_free: JointExcess::default(),
+        }
+    }
+
+    fn with_segment(mut obs: Observation) -> Observation {
+        let sim = crate::session::simulator::Simulator::new(
+            std::path::Path::new(crate::robot::model::DEFAULT_MODEL),
+            250,
+            crate::session::simulator::StartPose::standing(),
+            crate::robot::plant::Plant::default(),
+        )
+        .unwrap();
+        let tracker = crate::output::metrics::SegmentTracker::start(
+            "E-stop",
+            "E-stop",
+            &sim,
+            Default::default(),
+        );
+        obs.segments.push(tracker.finish());
+        obs
+    }
+
+    #[test]
+    fn an_abort_excuses_the_speed_before_the_latch_but_not_the_stop_itself() {
+        let judged = |obs| judge(Scenario::EStop, &with_segment(obs));
+        assert_eq!(judged(stopped(1.0, 0.5, false)).outcome, Outcome::Pass);
+        let slow = judged(stopped(1.0, 0.1, false));
+        assert_eq!(slow.outcome, Outcome::Missed);
+        assert_eq!(slow.check, "at top speed at the latch");
+        let aborted = judged(stopped(1.0, 0.1, true));
+        assert_eq!(aborted.outcome, Outcome::Aborted);
+        // Late torque-off after an abort: a miss, and the late torque-off is what decided it.
+        let late = judged(stopped(2.008, 0.1, true));
+        assert_eq!(late.outcome, Outcome::Missed);
+        assert_eq!(late.check, "torque-free by the SS1 deadline");
+        assert!(late.detail.contains("wheel_stall"), "{}", late.detail);
+    }
 }
