@@ -67,8 +67,8 @@ Tasks:
                      closed loop in-process; writes its table into docs/faults.md (--check: fail
                      if the table there is stale)
   campaign [opts]    the robustness campaign: N seeded trials (default 500), each a robot as
-                     built (masses, centre of mass, friction, wheel damping, IMU bias and noise,
-                     transport delay, drive ratings drawn from its seed) through every
+                     built (masses, centre of mass, friction, wheel damping, transport delay,
+                     drive ratings, its IMU chip and drive sensors drawn from its seed) through every
                      acceptance scenario on all cores; writes its table into
                      docs/campaign.md (--check: fail if the table there is stale; `test` runs
                      --trials 100 --check). --jobs N, --drives rated|ideal, --shard I/N with

@@ -1,13 +1,16 @@
 //! One trial's plant, drawn from its seed alone: the body (masses, centre of mass, friction,
-//! wheel damping), the IMU's bias and noise, the transport delay each way and the drives'
-//! torque ratings. The ranges are the robustness issue's; [`PARAMETERS`] lists them with the
-//! end of each range that is hard on the controller, for the table's "most extreme parameter".
+//! wheel damping), the transport delay, the drives' torque ratings, and which IMU chip and
+//! which drive sensors (their seeds) the robot carries. The ranges are the robustness issue's;
+//! [`BODY`] lists them with the end of each range that is hard on the controller, for the
+//! table's "most extreme parameter". Everything not drawn is [`Plant::default`]'s: a trial is
+//! the tested default robot, varied.
 //!
 //! The generator is SplitMix64, written out here rather than taken from `rand`: a seed then
 //! draws the same plant on every machine and with every version of every dependency, which
-//! is the contract of `--seed` (a trial is reproducible from its seed alone).
+//! is the contract of `--seed` (a trial is reproducible from its seed alone). The chip and the
+//! sensors draw their own parts from the seeds this stream gives them (the simulator's models,
+//! as `sim-host run --seed` does).
 
-use host_can::fault_plan::{FaultPlan, Faults};
 use serde::{Deserialize, Serialize};
 
 use crate::robot::plant::{DriveRatings, Plant};
@@ -50,6 +53,10 @@ pub enum Scale {
     Log,
     /// One of the whole numbers `lo…hi`, each as likely.
     Integer,
+    /// Not drawn here: the IMU chip draws it from its seed, normal with 1σ a quarter of the
+    /// range (the range is ±2σ, where 95 % of parts lie; the sweep sets its ends). Its `u` is
+    /// its place in that spread, Φ(value/σ).
+    Chip,
 }
 
 /// Which end of a parameter's range is hard on the controller.
@@ -95,17 +102,20 @@ impl Parameter {
         }
     }
 
-    /// The value of a uniform draw `u`.
-    pub fn value(&self, u: f64) -> f64 {
+    /// The value of a uniform draw `u` (a [`Scale::Chip`] parameter: `None`, the chip draws
+    /// it).
+    pub fn value(&self, u: f64) -> Option<f64> {
         let (lo, hi) = self.range;
         match self.scale {
-            Scale::Linear => lo + u * (hi - lo),
-            Scale::Log => lo * (hi / lo).powf(u),
-            Scale::Integer => (lo + (u * (hi - lo + 1.0)).floor()).min(hi),
+            Scale::Linear => Some(lo + u * (hi - lo)),
+            Scale::Log => Some(lo * (hi / lo).powf(u)),
+            Scale::Integer => Some((lo + (u * (hi - lo + 1.0)).floor()).min(hi)),
+            Scale::Chip => None,
         }
     }
 
-    /// How close a draw `u` lies to the hard end, 0 (mildest) … 1 (hardest).
+    /// How close a draw `u` lies to the hard end, 0 (mildest) … 1 (hardest). For a
+    /// [`Scale::Chip`] parameter, the share of parts closer to nominal.
     pub fn harshness(&self, u: f64) -> f64 {
         match self.harsh {
             Harsh::BothEnds => (2.0 * u - 1.0).abs(),
@@ -115,9 +125,11 @@ impl Parameter {
     }
 }
 
-/// Every drawn parameter, in draw order (changing the order changes every trial's plant).
-/// The IMU's are [`crate::campaign::imu::PARAMETERS`]'s, drawn last.
-pub const BODY: [Parameter; 10] = [
+/// The parameters drawn from the trial's stream, in draw order (changing the order changes
+/// every trial's plant): the list. After them the stream gives the IMU chip's seed and
+/// the drive sensors' seed; the chip's offsets, [`crate::campaign::imu::PARAMETERS`], follow
+/// from its seed.
+pub const BODY: [Parameter; 9] = [
     Parameter::new("mass", (0.9, 1.1), "×", Scale::Linear, Harsh::BothEnds),
     Parameter::new("com_x", (-0.02, 0.02), "m", Scale::Linear, Harsh::BothEnds),
     Parameter::new("com_y", (-0.02, 0.02), "m", Scale::Linear, Harsh::BothEnds),
@@ -132,14 +144,7 @@ pub const BODY: [Parameter; 10] = [
         Harsh::Low,
     ),
     Parameter::new(
-        "delay_tx",
-        (0.0, 2.0),
-        "cycles",
-        Scale::Integer,
-        Harsh::High,
-    ),
-    Parameter::new(
-        "delay_rx",
+        "transport_delay",
         (0.0, 2.0),
         "cycles",
         Scale::Integer,
@@ -149,98 +154,116 @@ pub const BODY: [Parameter; 10] = [
     Parameter::new("wheel_rating", (0.8, 1.0), "×", Scale::Linear, Harsh::Low),
 ];
 
-/// Every parameter, body then IMU: the columns of a trial's draw.
+/// Every parameter, drawn then the chip's: the columns of a trial's draw.
 pub fn parameters() -> impl Iterator<Item = &'static Parameter> {
     BODY.iter().chain(crate::campaign::imu::PARAMETERS.iter())
 }
 
-/// One trial's draw: per parameter of [`parameters`], the uniform `u` it came from.
+/// One trial's draw.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Draws {
     /// The seed.
     pub seed: u64,
-    /// `u` per parameter, in [`parameters`] order.
+    /// Per parameter of [`parameters`], the uniform `u` it came from (the chip's: its place in
+    /// the part spread).
     pub unit: Vec<f64>,
+    /// Per parameter of [`parameters`], its value.
+    pub values: Vec<f64>,
+    /// The IMU chip's seed: which part of the data sheet's spread the robot carries.
+    pub chip_seed: u64,
+    /// The drive sensors' seed: each joint's effort gain error.
+    pub sensing_seed: u64,
 }
 
 impl Draws {
     /// The draw of `seed`.
     pub fn of(seed: u64) -> Self {
         let mut draw = Draw::new(seed);
+        let mut unit = Vec::new();
+        let mut values = Vec::new();
+        for p in &BODY {
+            let u = draw.unit();
+            unit.push(u);
+            values.push(p.value(u).unwrap_or(0.0));
+        }
+        let chip_seed = draw.next_u64();
+        let sensing_seed = draw.next_u64();
+        for (u, value) in crate::campaign::imu::offsets(chip_seed) {
+            unit.push(u);
+            values.push(value);
+        }
         Self {
             seed,
-            unit: parameters().map(|_| draw.unit()).collect(),
+            unit,
+            values,
+            chip_seed,
+            sensing_seed,
         }
     }
 
     /// Parameter `name`'s value (0 for a name not drawn: a bug the tests catch).
     pub fn value(&self, name: &str) -> f64 {
         parameters()
-            .zip(&self.unit)
+            .zip(&self.values)
             .find(|(p, _)| p.name == name)
-            .map_or(0.0, |(p, u)| p.value(*u))
+            .map_or(0.0, |(_, v)| *v)
     }
 
     /// The parameter nearest its hard end, its value and harshness.
     pub fn most_extreme(&self) -> (&'static Parameter, f64, f64) {
         let mut best = (&BODY[0], self.value(BODY[0].name), -1.0);
-        for (p, u) in parameters().zip(&self.unit) {
+        for ((p, u), value) in parameters().zip(&self.unit).zip(&self.values) {
             let h = p.harshness(*u);
             if h > best.2 {
-                best = (p, p.value(*u), h);
+                best = (p, *value, h);
             }
         }
         best
     }
 
-    /// The plant these draws describe, on `drives` with their torques scaled.
+    /// The plant these draws describe, on `drives` with their torques scaled: the drawn body,
+    /// delay and ratings, this trial's chip and sensors.
     pub fn plant(&self, drives: DriveRatings) -> Plant {
-        plant_of(&|name| Some(self.value(name)), self.seed, drives)
-    }
-
-    /// The simulator's bus connection: feedback (`tx`) and commands (`rx`) late by the drawn
-    /// whole cycles.
-    pub fn faults(&self) -> Faults {
-        faults_of(&|name| Some(self.value(name)), self.seed)
+        let drawn = |name: &str| {
+            BODY.iter()
+                .any(|p| p.name == name)
+                .then(|| self.value(name))
+        };
+        let mut plant = plant_of(&drawn, drives);
+        plant.sensing.seed = self.sensing_seed;
+        crate::campaign::imu::fit_chip(&mut plant, self.chip_seed);
+        plant
     }
 }
 
 /// Parameter values by name: `Some` where set, `None` where the robot is as modelled.
 pub type Values<'a> = &'a dyn Fn(&str) -> Option<f64>;
 
-/// The plant with the parameters `value` sets, the rest as modelled, on `drives`; `seed`
-/// seeds the IMU's noise.
-pub fn plant_of(value: Values<'_>, seed: u64, drives: DriveRatings) -> Plant {
+/// [`Plant::default`] with the [`BODY`] parameters `value` sets, on `drives` (torques scaled
+/// by the ratings' parameters). The IMU and the sensors stay the default's.
+pub fn plant_of(value: Values<'_>, drives: DriveRatings) -> Plant {
+    let base = Plant::default();
+    let nominal = base.variation;
     let or = |name, nominal| value(name).unwrap_or(nominal);
     Plant {
-        imu_noise: crate::campaign::imu::noise(value, seed),
         drives: DriveRatings {
             leg_joint: scaled(drives.leg_joint, or("leg_rating", 1.0)),
             wheel: scaled(drives.wheel, or("wheel_rating", 1.0)),
         },
+        transport_delay_cycles: value("transport_delay")
+            .map_or(base.transport_delay_cycles, |cycles| cycles as u32),
         variation: Variation {
-            mass_scale: or("mass", 1.0),
-            leg_mass_scale: or("leg_mass", 1.0),
-            torso_com_offset_m: [or("com_x", 0.0), or("com_y", 0.0), 0.0],
-            friction: value("friction"),
-            wheel_damping_nm_s_rad: value("wheel_damping"),
+            mass_scale: or("mass", nominal.mass_scale),
+            leg_mass_scale: or("leg_mass", nominal.leg_mass_scale),
+            torso_com_offset_m: [
+                or("com_x", nominal.torso_com_offset_m[0]),
+                or("com_y", nominal.torso_com_offset_m[1]),
+                nominal.torso_com_offset_m[2],
+            ],
+            friction: value("friction").or(nominal.friction),
+            wheel_damping_nm_s_rad: value("wheel_damping").or(nominal.wheel_damping_nm_s_rad),
         },
-    }
-}
-
-/// The simulator's bus connection with the delays `value` sets (none where unset).
-pub fn faults_of(value: Values<'_>, seed: u64) -> Faults {
-    let cycles = |name| value(name).unwrap_or(0.0) as u32;
-    Faults {
-        tx: FaultPlan {
-            delay_cycles: cycles("delay_tx"),
-            ..FaultPlan::default()
-        },
-        rx: FaultPlan {
-            delay_cycles: cycles("delay_rx"),
-            ..FaultPlan::default()
-        },
-        seed,
+        ..base
     }
 }
 
@@ -270,42 +293,57 @@ mod tests {
         for seed in 0..200 {
             let draws = Draws::of(seed);
             assert_eq!(draws, Draws::of(seed));
-            for (p, u) in parameters().zip(&draws.unit) {
-                let v = p.value(*u);
-                assert!(
-                    (p.range.0..=p.range.1).contains(&v),
-                    "{}: {v} outside {:?}",
-                    p.name,
-                    p.range
-                );
+            assert_eq!(draws.values.len(), parameters().count());
+            for ((p, u), v) in parameters().zip(&draws.unit).zip(&draws.values) {
+                // The chip's offsets are normal: beyond ±2σ one part in twenty.
+                if p.scale != Scale::Chip {
+                    assert!(
+                        (p.range.0..=p.range.1).contains(v),
+                        "{}: {v} outside {:?}",
+                        p.name,
+                        p.range
+                    );
+                }
                 assert!((0.0..=1.0).contains(&p.harshness(*u)));
             }
         }
         assert_ne!(Draws::of(1), Draws::of(2));
+        assert_ne!(Draws::of(1).chip_seed, Draws::of(2).chip_seed);
     }
 
     #[test]
     fn integers_take_each_value_and_harshness_points_to_the_hard_end() {
         let delay = BODY[6];
-        assert_eq!(delay.value(0.0), 0.0);
-        assert_eq!(delay.value(0.5), 1.0);
-        assert_eq!(delay.value(0.999), 2.0);
+        assert_eq!(delay.name, "transport_delay");
+        assert_eq!(delay.value(0.0), Some(0.0));
+        assert_eq!(delay.value(0.5), Some(1.0));
+        assert_eq!(delay.value(0.999), Some(2.0));
         let damping = BODY[5];
-        assert!((damping.value(0.5) - 0.2).abs() < 1e-12);
+        assert!((damping.value(0.5).unwrap_or(0.0) - 0.2).abs() < 1e-12);
         assert_eq!(damping.harshness(0.0), 1.0);
         assert_eq!(BODY[1].harshness(0.5), 0.0);
     }
 
     #[test]
-    fn the_plant_carries_the_draws() {
+    fn the_plant_is_the_default_with_the_draws() {
         let draws = Draws::of(7);
         let plant = draws.plant(DriveRatings::RATED);
         let scale = draws.value("leg_rating");
         assert!((plant.drives.leg_joint.peak_torque_nm - 33.5 * scale).abs() < 1e-9);
         assert_eq!(plant.variation.mass_scale, draws.value("mass"));
         assert_eq!(
-            draws.faults().tx.delay_cycles,
-            draws.value("delay_tx") as u32
+            plant.transport_delay_cycles,
+            draws.value("transport_delay") as u32
         );
+        assert_eq!(plant.sensing.seed, draws.sensing_seed);
+        assert_eq!(plant.imu_noise.seed, draws.chip_seed);
+        let base = Plant::default();
+        assert_eq!(plant.imu, base.imu);
+        assert_eq!(
+            plant.sensing.effort_gain_error,
+            base.sensing.effort_gain_error
+        );
+        // Nothing set: the tested default itself.
+        assert_eq!(plant_of(&|_| None, base.drives), base);
     }
 }

@@ -3,7 +3,8 @@
 //! controller and reports what fraction of plausible robots the controller carries through
 //! each scenario, and how the rest fail.
 //!
-//! - [`draw`]: a trial's plant from its seed (body, delays, drive ratings), [`imu`]: its IMU;
+//! - [`draw`]: a trial's plant from its seed (body, delay, drive ratings, sensors), [`imu`]:
+//!   its IMU chip;
 //! - [`scenario`]: the scenarios' plans; [`observe`]: one run on the rig; [`judge`]: its verdict;
 //! - [`pool`]: runs on every core; [`results`]: the JSON file, shards and their merge;
 //!   [`table`]: the Markdown table of `docs/campaign.md`; [`sweep`]: one parameter at a time;
@@ -119,7 +120,7 @@ pub fn observe_one(
         model,
         scenario,
         draws.plant(drives.ratings()),
-        &draws.faults(),
+        &host_can::fault_plan::Faults::default(),
     )
 }
 

@@ -1,5 +1,6 @@
-//! One parameter at a time: the robot as modelled (no IMU noise, no delay, drives at their
-//! rating) with a single parameter at one end of its campaign range, through every scenario.
+//! One parameter at a time: the tested default robot ([`crate::robot::plant::Plant::default`]:
+//! its chip, its sensors, its delay, drives at their rating) with a single parameter at one end
+//! of its campaign range, through every scenario.
 //! Where the random trials show how often the controller fails, this shows which parameter
 //! alone is enough to make it fail, and how: the campaign's causes, separated.
 
@@ -9,7 +10,7 @@ use std::path::Path;
 use host_can::fault_plan::Faults;
 use serde::{Deserialize, Serialize};
 
-use crate::campaign::draw::{faults_of, parameters, plant_of, Parameter};
+use crate::campaign::draw::{parameters, plant_of, Parameter};
 use crate::campaign::judge::{Outcome, Verdict};
 use crate::campaign::pool::run_all;
 use crate::campaign::scenario::Scenario;
@@ -56,10 +57,15 @@ impl Setting {
         }
     }
 
-    fn plant_and_faults(&self, drives: Drives) -> (crate::robot::plant::Plant, Faults) {
+    /// The default plant on `drives` with this setting.
+    fn plant(&self, drives: Drives) -> crate::robot::plant::Plant {
         let name = self.parameter.map(|p| p.name);
         let value = |n: &str| (Some(n) == name).then_some(self.value);
-        (plant_of(&value, 1, drives.ratings()), faults_of(&value, 1))
+        let mut plant = plant_of(&value, drives.ratings());
+        if let Some(name) = name {
+            crate::campaign::imu::set_offset(&mut plant, name, self.value);
+        }
+        plant
     }
 }
 
@@ -87,12 +93,12 @@ pub fn run(
         .flat_map(|setting| scenarios.iter().map(move |s| (setting, *s)))
         .collect();
     let work = |&(setting, scenario): &(Setting, Scenario)| {
-        let (plant, faults) = setting.plant_and_faults(drives);
+        let plant = setting.plant(drives);
         SweepRun {
             setting: setting.label(),
             scenario,
             verdict: judged(scenario, || {
-                crate::campaign::observe::run(model, scenario, plant, &faults)
+                crate::campaign::observe::run(model, scenario, plant, &Faults::default())
             }),
         }
     };
@@ -179,13 +185,13 @@ mod tests {
             run("as modelled", Scenario::L, Outcome::Pass, ""),
             run("mass = 0.9 ×", Scenario::W, Outcome::Pass, ""),
             run("mass = 0.9 ×", Scenario::L, Outcome::Pass, ""),
-            run("delay_rx = 2", Scenario::W, Outcome::Aborted, "tilt"),
-            run("delay_rx = 2", Scenario::L, Outcome::Missed, "roll"),
+            run("transport_delay = 2", Scenario::W, Outcome::Aborted, "tilt"),
+            run("transport_delay = 2", Scenario::L, Outcome::Missed, "roll"),
         ];
         let text = markdown(&runs, &scenarios);
         assert!(text.contains("| as modelled | pass | pass |"), "{text}");
         assert!(
-            text.contains("| delay_rx = 2 | abort: wheel_stall | **missed**: roll |"),
+            text.contains("| transport_delay = 2 | abort: wheel_stall | **missed**: roll |"),
             "{text}"
         );
         assert!(

@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
-use crate::campaign::draw::{parameters, Draws};
+use crate::campaign::draw::{parameters, Draws, Parameter, Scale};
 use crate::campaign::judge::Outcome;
 use crate::campaign::results::Results;
 use crate::campaign::scenario::Scenario;
@@ -180,7 +180,8 @@ pub fn with_unit(text: &str, unit: &str) -> String {
 fn by_parameter(runs: &[RunResult]) -> String {
     let mut text = String::from(
         "Failure rate (runs not passing, safe aborts included) by the third of its range each \
-         parameter was drawn in, mild to hard:\n\n\
+         parameter was drawn in, mild to hard (the chip's offsets: by the third of the parts' \
+         spread, nearest nominal to farthest):\n\n\
          | parameter | range | mildest third | middle | hardest third |\n|---|---|---|---|---|\n",
     );
     let draws: BTreeMap<u64, Draws> = runs.iter().map(|r| (r.seed, Draws::of(r.seed))).collect();
@@ -197,15 +198,17 @@ fn by_parameter(runs: &[RunResult]) -> String {
             }
         }
         let [a, b, c] = bins.map(|(bad, all)| percent(bad, all));
-        let _ = writeln!(
-            text,
-            "| {} | {} | {a} | {b} | {c} |",
-            p.name,
-            with_unit(
-                &format!("{} … {}", significant(p.range.0), significant(p.range.1)),
-                p.unit
-            ),
-        );
+        let _ = writeln!(text, "| {} | {} | {a} | {b} | {c} |", p.name, range_text(p));
     }
     text
+}
+
+/// A parameter's range for the tables: `lo … hi unit`, or for the chip's offsets their
+/// spread, `normal, 1σ s unit`.
+pub fn range_text(p: &Parameter) -> String {
+    let text = match p.scale {
+        Scale::Chip => format!("normal, 1σ {}", significant(p.range.1 / 2.0)),
+        _ => format!("{} … {}", significant(p.range.0), significant(p.range.1)),
+    };
+    with_unit(&text, p.unit)
 }

@@ -195,6 +195,11 @@ fn one_trial(args: &CampaignArgs, campaign: &Campaign, seed: u64) -> Result<(), 
     for p in parameters() {
         println!("  {:<18} {:>12.6} {}", p.name, draws.value(p.name), p.unit);
     }
+    println!(
+        "  {:<18} {:>12} (the BMI088's part: its offsets above)\n  {:<18} {:>12} (each \
+         joint's effort gain error)",
+        "chip seed", draws.chip_seed, "sensing seed", draws.sensing_seed
+    );
     for &scenario in &campaign.scenarios {
         let obs = sim_host::campaign::observe_one(&args.model, campaign.drives, &draws, scenario);
         let obs = match obs {

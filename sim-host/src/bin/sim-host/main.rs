@@ -47,8 +47,8 @@ enum Command {
         model: PathBuf,
     },
     /// Run the robustness campaign: N seeded trials, each a robot as built (masses, centre of
-    /// mass, friction, wheel damping, IMU bias and noise, transport delay, drive ratings drawn
-    /// from its seed), through every acceptance scenario on all cores; judged by the
+    /// mass, friction, wheel damping, transport delay, drive ratings, its BMI088 chip and its
+    /// drive sensors drawn from its seed), through every acceptance scenario on all cores; judged by the
     /// acceptance figures. Prints a Markdown table, writes the results as JSON. A run that
     /// fails is a result: the exit code is 0 unless the campaign itself could not run.
     ///
