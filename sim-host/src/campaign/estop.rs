@@ -35,7 +35,9 @@ pub struct StopFigures {
 #[derive(Debug, Clone)]
 pub struct StopTracker {
     figures: StopFigures,
-    elapsed_s: f64,
+    /// Cycles observed since the latch (time from whole cycles: a sum of 4 ms steps would put
+    /// a torque-off at the deadline 1e-15 s past it).
+    cycles: u64,
 }
 
 impl StopTracker {
@@ -49,13 +51,14 @@ impl StopTracker {
                 held: true,
                 ..StopFigures::default()
             },
-            elapsed_s: 0.0,
+            cycles: 0,
         }
     }
 
     /// Takes the cycle the rig just ran (`record`, its last).
     pub fn observe(&mut self, rig: &Rig, record: &CycleRecord) {
-        self.elapsed_s += PERIOD_US as f64 * 1e-6;
+        self.cycles += 1;
+        let elapsed_s = (self.cycles * PERIOD_US) as f64 / 1e6;
         let f = &mut self.figures;
         let torso = rig.sim().physics().torso();
         let tilt = record.tilt_deg;
@@ -71,14 +74,14 @@ impl StopTracker {
                 f.max_tilt_to_rest_deg = f.max_tilt_to_rest_deg.max(tilt);
             }
             if drives_off && controller_off {
-                f.off_after_s = Some(self.elapsed_s);
+                f.off_after_s = Some(elapsed_s);
             }
         } else {
             f.held &= drives_off && controller_off;
             f.max_drop_after_off_m_s = f.max_drop_after_off_m_s.max(drop);
         }
         if f.rest_after_s.is_none() && torso.vel_m_s[0].hypot(torso.vel_m_s[1]) < 0.02 {
-            f.rest_after_s = Some(self.elapsed_s);
+            f.rest_after_s = Some(elapsed_s);
         }
         f.final_tilt_deg = tilt;
     }

@@ -1,7 +1,7 @@
 //! A run's verdict. The criteria are the acceptance tests' figures, with the one rule
 //! for a plant that makes a motion impossible: a run that misses its figures passes only if
 //! the firmware stopped it on its own and said why (`Fault`, or an `EStop` nobody sent, with a
-//! cause flag) and the robot did not fall. Whatever else happened, a fall, a joint past its
+//! cause flag, or a refusal of motion on a degraded link) and the robot did not fall. Whatever else happened, a fall, a joint past its
 //! range, a wheel torque past its limit or a panic fails the run.
 
 use serde::{Deserialize, Serialize};
@@ -229,14 +229,16 @@ fn checks(scenario: Scenario, obs: &Observation) -> Vec<Check> {
         Scenario::L => trotting(s, 1.0),
         Scenario::K => trotting(s, -1.0),
         Scenario::Fold => {
+            // The time last: the fold in place ends just after 4 s even as modelled (see
+            // tests/campaign.rs), so a run that also tilts or touches down is named for that.
             let balancing = obs.balancing_at_s.unwrap_or(f64::INFINITY);
-            let mut c = vec![at_most(
+            let mut c = wheels_only(s);
+            c.push(at_most(
                 "balancing on the wheels by 4 s",
                 balancing,
                 4.0,
                 "s",
-            )];
-            c.extend(wheels_only(s));
+            ));
             c
         }
         Scenario::XFromW | Scenario::XFromL => vec![

@@ -35,7 +35,8 @@ pub struct Observation {
     pub segments: Vec<SegmentSummary>,
     /// First cycle fallen (tilt past 45° or the torso down), rig time, s.
     pub fell_at_s: Option<f64>,
-    /// First cycle in `Fault`, or in `EStop` before any E-stop was sent, with a cause flag.
+    /// First cycle in `Fault`, or in `EStop` before any E-stop was sent, with a cause flag, or
+    /// refusing motion on a degraded link (`link_degraded` reported).
     pub abort: Option<Abort>,
     /// First cycle balancing on the wheels, rig time, s.
     pub balancing_at_s: Option<f64>,
@@ -178,10 +179,12 @@ impl Watch {
             self.fell_at_s = Some(t);
         }
         let estop_sent = self.stop.is_some();
+        // A degraded link is the controller's one refusal outside `Fault`: it stops once and
+        // refuses new motion while it reports the flag.
         let stopped = match record.state {
             Some(State::Fault) => true,
             Some(State::EStop) => !estop_sent,
-            _ => false,
+            _ => record.faults.contains(FaultFlags::LINK_DEGRADED),
         };
         let cause = record.faults.without(FaultFlags::AWAITING_STOP);
         if stopped && self.abort.is_none() && !cause.is_empty() {
