@@ -1,6 +1,6 @@
 //! The robustness campaign (`sim_host::campaign`) as an instrument: on the acceptance tests'
-//! own plant its judge passes every scenario (so a failure in a campaign is the plant's doing,
-//! not the judge's), a seed reruns to the same verdict whatever the number of workers, and
+//! own plant (`Plant::default()`) its judge passes every scenario but the known findings (so a
+//! failure in a campaign is the plant's or the controller's doing, not the judge's), a seed reruns to the same verdict whatever the number of workers, and
 //! shards merged give the results and the table of one whole run.
 //!
 //! Run in release for speed: `cargo test --release -p sim-host --test campaign`.
