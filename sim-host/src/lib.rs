@@ -11,10 +11,12 @@
 //! - [`session`]: one closed-loop run, with the firmware in-process or over SocketCAN;
 //! - [`output`]: what a user looks at — telemetry CSV, the candump log, `summary.json`, plots,
 //!   rendered frames, the viewer;
-//! - [`faults`]: the fault matrix and the rig it runs on.
+//! - [`faults`]: the fault matrix and the rig it runs on;
+//! - [`campaign`]: the robustness campaign, the acceptance scenarios on many drawn robots.
 // Functions stay short enough to read whole (clippy.toml: 80 lines); tests may run longer.
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
+pub mod campaign;
 pub mod clock;
 pub mod error_chain;
 pub mod faults;

@@ -5,6 +5,7 @@
 mod apt;
 mod bench;
 mod busload;
+mod campaign;
 mod dbc;
 mod demo;
 mod elf;
@@ -65,6 +66,15 @@ Tasks:
                      silent feedback, a killed firmware, a restarted simulator, E-stops) on the
                      closed loop in-process; writes its table into docs/faults.md (--check: fail
                      if the table there is stale)
+  campaign [opts]    the robustness campaign: N seeded trials (default 500), each a robot as
+                     built (masses, centre of mass, friction, wheel damping, transport delay,
+                     drive ratings, its IMU chip and drive sensors drawn from its seed) through every
+                     acceptance scenario on all cores; writes its table into
+                     docs/campaign.md (--check: fail if the table there is stale; `test` runs
+                     --trials 100 --check). --jobs N, --drives rated|ideal, --shard I/N with
+                     --results FILE (a part, for --merge FILE…), --seed S [--scenario NAME]
+                     (rerun one trial, every figure), --scaling N (runs/s on 1 and 2 workers),
+                     --sweep (one parameter at a time at each end of its range)
   mutants [FILE…]    mutation testing (cargo-mutants, installed if missing) of the
                      safety-critical modules: fails on a mutant no test kills (long: minutes per
                      file; not part of `test`)
@@ -106,6 +116,7 @@ fn main() -> ExitCode {
         "pil" => pil::run(rest),
         "fuzz" => fuzz::run(rest),
         "faults" => faults::run(rest),
+        "campaign" => campaign::run(rest),
         "same-run" => same_run::run(rest),
         "mutants" => mutants::run(rest),
         "soak" => soak::run(rest),

@@ -78,6 +78,13 @@ pub fn run() -> Result<(), String> {
     crate::fuzz::ci()?;
     // Ten simulated minutes of the soak (the day is `cargo xtask soak`).
     crate::soak::run(&["--minutes".to_string(), "10".to_string()])?;
+    // A hundred trials of the robustness campaign; the table in docs/campaign.md must be the
+    // one they give (the 500-trial run is `cargo xtask campaign`).
+    crate::campaign::run(&[
+        "--trials".to_string(),
+        "100".to_string(),
+        "--check".to_string(),
+    ])?;
     crate::hil::run(&[])?;
     eprintln!("test: all checks passed");
     Ok(())

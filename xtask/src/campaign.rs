@@ -1,0 +1,179 @@
+//! `cargo xtask campaign`: the robustness campaign (`sim-host campaign`, release build) and its
+//! table in docs/campaign.md. A whole run or a merge of shards writes the table between the
+//! markers of its size, `campaign:N` (`campaign:N:ideal` on ideal drives), `--sweep` (one
+//! parameter at a time) between `campaign:sweep` (`campaign:sweep:ideal`); `--check` fails when
+//! the table there differs from a fresh run (runs are lockstep and seeded: they repeat
+//! exactly). A shard, a single trial (`--seed`) and the pool's speed-up (`--scaling`) only
+//! print; the shard writes its partial results for `--merge`.
+//!
+//! The results JSON goes to target/campaign/results.json unless `--results FILE` says
+//! otherwise.
+
+use std::path::PathBuf;
+use std::process::Stdio;
+
+use crate::faults::write_section;
+use crate::util::{cargo, root};
+
+const USAGE: &str = "usage: cargo xtask campaign [--trials N] [--jobs N] [--drives rated|ideal] \
+     [--check] | --sweep [--drives rated|ideal] [--check] | --shard I/N [--results FILE] | \
+     --merge FILE… [--check] | --seed S [--scenario NAME]… | --scaling N";
+/// The page the tables live in, relative to the workspace root.
+const PAGE: &str = "docs/campaign.md";
+
+/// What the command line asks for.
+#[derive(Debug, Default, PartialEq)]
+struct Args {
+    /// Passed on to `sim-host campaign`.
+    forward: Vec<String>,
+    check: bool,
+    results: Option<PathBuf>,
+    /// Only prints (a shard, one trial, the speed-up): no table to write.
+    print_only: bool,
+    /// A scenario subset: its table has no place in the page.
+    subset: bool,
+    /// One parameter at a time (`--sweep`): its own section.
+    sweep: bool,
+    /// Ideal drives (`--drives ideal`): their own sections.
+    ideal: bool,
+}
+
+fn parse(args: &[String]) -> Result<Args, String> {
+    let mut parsed = Args::default();
+    let mut it = args.iter().peekable();
+    while let Some(flag) = it.next() {
+        let value = |it: &mut std::iter::Peekable<std::slice::Iter<'_, String>>| {
+            it.next()
+                .cloned()
+                .ok_or_else(|| format!("{flag} needs a value\n{USAGE}"))
+        };
+        match flag.as_str() {
+            "--check" => parsed.check = true,
+            "--results" => parsed.results = Some(PathBuf::from(value(&mut it)?)),
+            "--trials" | "--jobs" | "--drives" => {
+                let v = value(&mut it)?;
+                parsed.ideal |= flag == "--drives" && v == "ideal";
+                parsed.forward.extend([flag.clone(), v]);
+            }
+            "--sweep" => {
+                parsed.forward.push(flag.clone());
+                parsed.sweep = true;
+            }
+            "--shard" | "--seed" | "--scaling" => {
+                parsed.forward.extend([flag.clone(), value(&mut it)?]);
+                parsed.print_only = true;
+            }
+            "--scenario" => {
+                parsed.forward.extend([flag.clone(), value(&mut it)?]);
+                parsed.subset = true;
+            }
+            "--merge" => {
+                parsed.forward.push(flag.clone());
+                while let Some(file) = it.next_if(|a| !a.starts_with("--")) {
+                    parsed.forward.push(file.clone());
+                }
+            }
+            other => return Err(format!("unknown option `{other}`\n{USAGE}")),
+        }
+    }
+    if parsed.check && (parsed.print_only || parsed.subset) {
+        return Err(format!(
+            "--check compares a whole campaign's table\n{USAGE}"
+        ));
+    }
+    Ok(parsed)
+}
+
+pub fn run(args: &[String]) -> Result<(), String> {
+    let args = parse(args)?;
+    crate::mujoco::ensure()?;
+    let results = args
+        .results
+        .clone()
+        .unwrap_or_else(|| root().join("target").join("campaign").join("results.json"));
+    let mut cmd = cargo();
+    cmd.args(["run", "--release", "-q", "-p", "sim-host", "--", "campaign"])
+        .args(&args.forward)
+        .arg("--results")
+        .arg(&results)
+        .stderr(Stdio::inherit());
+    eprintln!(
+        "$ cargo run --release -p sim-host -- campaign {}",
+        args.forward.join(" ")
+    );
+    if args.print_only || args.subset {
+        let status = cmd
+            .status()
+            .map_err(|e| format!("could not run sim-host: {e}"))?;
+        return status
+            .success()
+            .then_some(())
+            .ok_or_else(|| format!("sim-host campaign failed ({status})"));
+    }
+    let out = cmd
+        .output()
+        .map_err(|e| format!("could not run sim-host: {e}"))?;
+    let table = String::from_utf8_lossy(&out.stdout).into_owned();
+    print!("{table}");
+    if !out.status.success() {
+        return Err(format!("sim-host campaign failed ({})", out.status));
+    }
+    let key = if args.sweep {
+        format!("campaign:sweep{}", if args.ideal { ":ideal" } else { "" })
+    } else {
+        section_key(&results)?
+    };
+    let begin = format!("<!-- {key}:begin (generated by `cargo xtask campaign`) -->");
+    let end = format!("<!-- {key}:end -->");
+    write_section(
+        &root().join(PAGE),
+        &begin,
+        &end,
+        &table,
+        args.check,
+        "campaign",
+    )
+}
+
+/// The page's section for the campaign in `results`: `campaign:N`, `:ideal` on ideal drives.
+fn section_key(results: &std::path::Path) -> Result<String, String> {
+    let text = std::fs::read_to_string(results)
+        .map_err(|e| format!("{}: {e} (sim-host wrote no results)", results.display()))?;
+    let json: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| format!("{}: {e}", results.display()))?;
+    let campaign = &json["campaign"];
+    let trials = campaign["trials"]
+        .as_u64()
+        .ok_or_else(|| format!("{}: no campaign.trials", results.display()))?;
+    Ok(match campaign["drives"].as_str() {
+        Some("ideal") => format!("campaign:{trials}:ideal"),
+        _ => format!("campaign:{trials}"),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn strings(args: &[&str]) -> Vec<String> {
+        args.iter().map(|s| (*s).to_owned()).collect()
+    }
+
+    #[test]
+    fn a_whole_run_writes_the_page_and_a_shard_or_a_trial_only_prints() {
+        let whole = parse(&strings(&["--trials", "100", "--check"])).unwrap();
+        assert!(whole.check && !whole.print_only);
+        assert_eq!(whole.forward, strings(&["--trials", "100"]));
+        let shard = parse(&strings(&["--shard", "1/4", "--results", "a.json"])).unwrap();
+        assert!(shard.print_only);
+        assert_eq!(shard.results, Some(PathBuf::from("a.json")));
+        let merge = parse(&strings(&["--merge", "a.json", "b.json", "--check"])).unwrap();
+        assert!(!merge.print_only && merge.check);
+        assert_eq!(merge.forward, strings(&["--merge", "a.json", "b.json"]));
+        assert!(parse(&strings(&["--seed", "3", "--check"])).is_err());
+        let sweep = parse(&strings(&["--sweep", "--drives", "ideal"])).unwrap();
+        assert!(sweep.sweep && sweep.ideal && !sweep.print_only);
+        assert!(parse(&strings(&["--trials"])).is_err());
+        assert!(parse(&strings(&["--bogus"])).is_err());
+    }
+}
