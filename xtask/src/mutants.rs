@@ -14,8 +14,9 @@ use crate::util::{cargo, root, run as sh};
 /// The safety-critical modules: the receive checks, the session and the sealing of frames, the
 /// CMAC, the watchdogs and clamps, the link monitor, the operator-command budget, the operator
 /// requests and the restart interlock, the mode machine, the controlled stop, the node with its
-/// acceptance filter and release token, its memory across restarts, and the service loop.
-const FILES: [&str; 14] = [
+/// acceptance filter and release token, its memory across restarts, the service loop, and the
+/// stall and runaway detector.
+const FILES: [&str; 15] = [
     "protocol/src/e2e.rs",
     "protocol/src/receiver.rs",
     "protocol/src/session.rs",
@@ -30,6 +31,7 @@ const FILES: [&str; 14] = [
     "firmware/src/node/mod.rs",
     "firmware/src/node/persist.rs",
     "firmware/src/node/service.rs",
+    "firmware/src/wheels/runaway.rs",
 ];
 
 /// Mutants that survive because no behaviour tells them apart, with the reason. Each entry is

@@ -10,6 +10,7 @@ pub mod clock;
 pub mod frames;
 pub mod protected;
 pub mod recorded;
+pub mod rejects;
 pub mod search;
 
 macro_rules! raw_strategy {
