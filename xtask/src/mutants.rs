@@ -36,7 +36,7 @@ const FILES: [&str; 15] = [
 
 /// Mutants that survive because no behaviour tells them apart, with the reason. Each entry is
 /// the start of the line cargo-mutants prints in `missed.txt`.
-const EQUIVALENT: [(&str, &str); 3] = [
+const EQUIVALENT: [(&str, &str); 7] = [
     (
         "firmware/src/node/mod.rs:144:9: replace Node::encode_failures -> u32 with 0",
         "no message can fail to encode (their sizes are checked at compile time), so the count \
@@ -45,6 +45,25 @@ const EQUIVALENT: [(&str, &str); 3] = [
     (
         "firmware/src/node/mod.rs:201:31: replace match guard previous == now with false",
         "the same tick again then adds its 0 ticks to the session time: the same time",
+    ),
+    (
+        "firmware/src/wheels/runaway.rs:79:62: replace * with / in RunawayInput::cause",
+        "the speed times the reference's sign (±1: f32::signum is never 0) is the speed \
+         divided by it",
+    ),
+    (
+        "firmware/src/wheels/runaway.rs:80:54: replace * with / in RunawayInput::cause",
+        "as above: ±1 multiplies and divides alike",
+    ),
+    (
+        "firmware/src/wheels/runaway.rs:154:37: replace * with / in Runaway::update",
+        "the error's rate times the reference's sign (±1: f32::signum is never 0) is the rate \
+         divided by it",
+    ),
+    (
+        "firmware/src/wheels/runaway.rs:154:71: replace < with <= in Runaway::update",
+        "they differ only at a rate of exactly 0, which is never a collision (the rate must \
+         also be past the collision bound)",
     ),
     (
         "protocol/src/sender.rs:57:38: replace match guard key == session.key() with false",

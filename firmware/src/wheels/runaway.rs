@@ -278,6 +278,65 @@ mod tests {
     }
 
     #[test]
+    fn a_robot_stopped_hard_driving_backward_trips_as_a_stall() {
+        let mut runaway = detector();
+        for _ in 0..50 {
+            assert_eq!(runaway.update(&CONFIG, &input(-0.48, -0.48, -10.0)), None);
+        }
+        let mut speed = -0.48;
+        let found = (1..=100).find_map(|tick| {
+            speed = f32::min(speed + 4.8 * 0.004, 0.0);
+            let cause = runaway.update(&CONFIG, &input(speed, -0.48, -10.0));
+            cause.map(|cause| (tick, cause))
+        });
+        let (tick, cause) = found.expect("never tripped");
+        assert_eq!(cause, FaultFlags::WHEEL_STALL);
+        assert!((ticks(24)..=ticks(24) + 4).contains(&tick), "{tick}");
+    }
+
+    #[test]
+    fn a_sudden_stop_trips_as_a_stall_although_the_robot_no_longer_follows() {
+        // Whether the robot had followed its reference is judged before the deceleration:
+        // the collision itself takes it far from the reference at once.
+        let mut runaway = detector();
+        for _ in 0..ticks(CONFIG.following_ms) + 1 {
+            assert_eq!(runaway.update(&CONFIG, &input(0.48, 0.48, 10.0)), None);
+        }
+        let mut speed = 0.24;
+        let found = (1..=100).find_map(|tick| {
+            let cause = runaway.update(&CONFIG, &input(speed, 0.48, 10.0));
+            speed = f32::max(speed - 3.0 * 0.004, 0.0);
+            cause.map(|cause| (tick, cause))
+        });
+        let (tick, cause) = found.expect("never tripped");
+        assert_eq!(cause, FaultFlags::WHEEL_STALL);
+        assert!(tick <= ticks(24) + 4, "{tick}");
+    }
+
+    #[test]
+    fn an_error_at_its_bound_is_within_it() {
+        let mut runaway = detector();
+        let at_bound = input(CONFIG.speed_error_m_s, 0.0, 0.0);
+        assert_eq!(ticks_to_trip(&mut runaway, &at_bound), None);
+    }
+
+    #[test]
+    fn a_push_along_the_reference_is_no_collision() {
+        let mut runaway = detector();
+        for _ in 0..50 {
+            assert_eq!(runaway.update(&CONFIG, &input(0.48, 0.48, 10.0)), None);
+        }
+        // Shoved forward at 5 m/s² for 60 ms: as sharp as a collision, but along the
+        // reference.
+        let mut speed = 0.48;
+        for tick in 0..15 {
+            speed += 5.0 * 0.004;
+            let found = runaway.update(&CONFIG, &input(speed, 0.48, 10.0));
+            assert_eq!(found, None, "{tick}");
+        }
+    }
+
+    #[test]
     fn a_robot_swinging_about_its_reference_is_no_collision() {
         // A delayed loop's limit cycle: ±0.3 m/s at 3 Hz about 0.2 m/s, peaks of 5.7 m/s².
         let mut runaway = detector();
