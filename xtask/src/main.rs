@@ -75,9 +75,10 @@ Tasks:
                      --results FILE (a part, for --merge FILE…), --seed S [--scenario NAME]
                      (rerun one trial, every figure), --scaling N (runs/s on 1 and 2 workers),
                      --sweep (one parameter at a time at each end of its range)
-  mutants [FILE…]    mutation testing (cargo-mutants, installed if missing) of the
+  mutants [--iterate] [FILE…]
+                     mutation testing (cargo-mutants, installed if missing) of the
                      safety-critical modules: fails on a mutant no test kills (long: minutes per
-                     file; not part of `test`)
+                     file; not part of `test`); --iterate: only what the last run missed
   soak [--minutes N] sim-host in-process for N simulated minutes (default 1440: a day), every
                      output on (streamed to /dev/null), turning in place; fails if its resident
                      memory grows more than 5 MB after minute 5 (`test` runs 10 minutes)
