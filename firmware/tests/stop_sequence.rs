@@ -63,6 +63,14 @@ fn assert_off_before_the_deadline(poses: &[Joints<f32>]) {
     );
 }
 
+/// The last pose is the kickstand (which it returns).
+fn assert_settled_in_the_kickstand(poses: &[Joints<f32>]) -> Joints<f32> {
+    let kickstand = CONFIG.stop.kickstand();
+    let last = poses.last().expect("poses");
+    assert_close(last, &kickstand, 1e-5, "the settled pose");
+    kickstand
+}
+
 fn assert_close(a: &Joints<f32>, b: &Joints<f32>, tolerance: f32, what: &str) {
     for (x, y) in a.iter().zip(b.iter()) {
         assert!((x - y).abs() <= tolerance, "{what}: {a:?} against {b:?}");
@@ -76,9 +84,7 @@ fn from_the_wheels_the_front_legs_swing_out_midway_and_every_leg_ends_in_the_kic
     let mut stop = Stop::new(CONFIG.stop, CONFIG.rate, start, fold, fold, Carrier::Wheels);
     let poses = poses_until_off(&mut stop, start);
     assert_off_before_the_deadline(&poses);
-    let kickstand = CONFIG.stop.kickstand();
-    let last = poses.last().expect("poses");
-    assert_close(last, &kickstand, 1e-5, "the settled pose");
+    assert_settled_in_the_kickstand(&poses);
     // Fold and kickstand both have no abduction: what abduction there is, is the swing out.
     let abduction = |pose: &Joints<f32>, leg: Leg| pose.leg(leg)[0];
     let spread = CONFIG.stop.kickstand_spread_rad;
@@ -119,13 +125,7 @@ fn from_the_legs_the_sit_down_rises_first_at_the_fastest_rate_then_lowers_slowly
     let mut stop = Stop::new(CONFIG.stop, CONFIG.rate, start, stand, fold, Carrier::Legs);
     let poses = poses_until_off(&mut stop, start);
     assert_off_before_the_deadline(&poses);
-    let kickstand = CONFIG.stop.kickstand();
-    assert_close(
-        poses.last().expect("poses"),
-        &kickstand,
-        1e-5,
-        "the settled pose",
-    );
+    let kickstand = assert_settled_in_the_kickstand(&poses);
     // The rise: the first share of the straight way, over a ramp at the kickstand's rate.
     let share = CONFIG.stop.sit_rise_share;
     let risen = Joints::from_leg_fn(|leg| {
@@ -249,13 +249,7 @@ fn a_robot_that_never_comes_to_rest_still_ends_in_the_kickstand_before_the_cut()
     });
     assert_off_before_the_deadline(&poses);
     // It brakes as long as the kickstand leaves time for, then sits down at the fastest rate.
-    let kickstand = CONFIG.stop.kickstand();
-    assert_close(
-        poses.last().expect("poses"),
-        &kickstand,
-        1e-5,
-        "the settled pose",
-    );
+    let kickstand = assert_settled_in_the_kickstand(&poses);
     let first_move = poses.iter().position(|pose| pose != &fold).expect("moved");
     let needed = ramp_ticks(
         &fold,

@@ -7,43 +7,19 @@
 
 use std::path::Path;
 
-use firmware::control::fsm::State;
 use firmware::control::safety::SS1_DEADLINE_MS;
 use host_can::fault_plan::Faults;
-use protocol::{AnyMessage, EStop, FaultFlags, NodeId, Session, TeleopMode, TEST_KEY};
+use protocol::{AnyMessage, EStop, NodeId, Session, TeleopMode, TEST_KEY};
+use sim_host::campaign::estop::{StopFigures, StopTracker};
 use sim_host::faults::rig::{Rig, PERIOD_US};
 use sim_host::robot::model::DEFAULT_MODEL;
 use teleop_core::scripted::PlanStep;
 
-/// What one E-stop did, from the latch on.
-#[derive(Debug, Default)]
+/// What one E-stop did, from the latch on, and whether the robot fell (tilt past 45° or the
+/// torso on the ground).
+#[derive(Debug)]
 struct Figures {
-    /// Horizontal torso speed when the latch went out, m/s.
-    speed_at_latch_m_s: f64,
-    /// From the latch until the torso's horizontal speed first fell below 2 cm/s, s.
-    rest_after_s: Option<f64>,
-    /// Largest tilt from the latch until rest (or until torque-off if never at rest), degrees.
-    max_tilt_to_rest_deg: f64,
-    /// Largest tilt from the latch until torque-off, degrees.
-    max_tilt_to_off_deg: f64,
-    /// From the latch until the controller disabled every drive (legs disabled, wheel torque
-    /// 0) and every drive was torque-free, s.
-    off_after_s: Option<f64>,
-    /// Whether every cycle from the latch on reported `EStop` and `ESTOP_LATCHED`.
-    reported: bool,
-    /// Whether every drive stayed torque-free from the first cycle it was until the end.
-    held: bool,
-    /// Fastest downward torso-centre speed from the latch until torque-off, m/s.
-    max_drop_before_off_m_s: f64,
-    /// … from torque-off to the end, m/s.
-    max_drop_after_off_m_s: f64,
-    /// Largest tilt from torque-off to the end, degrees.
-    max_tilt_after_off_deg: f64,
-    /// Tilt at the end, degrees.
-    final_tilt_deg: f64,
-    /// Torso-centre height at the latch and at the end, m.
-    height_m: [f64; 2],
-    /// Whether the robot fell (tilt past 45° or the torso on the ground).
+    stop: StopFigures,
     fell: bool,
 }
 
@@ -52,55 +28,24 @@ fn estop(plan: Vec<PlanStep>, latch_s: f64, end_s: f64) -> Figures {
     let model = Path::new(DEFAULT_MODEL);
     let mut rig = Rig::new(model, plan, &Faults::default(), &Faults::default()).unwrap();
     rig.run_until(latch_s).unwrap();
-    let torso = rig.sim().physics().torso();
-    let mut f = Figures {
-        speed_at_latch_m_s: torso.vel_m_s[0].hypot(torso.vel_m_s[1]),
-        reported: true,
-        held: true,
-        height_m: [torso.pos_m[2], 0.0],
-        ..Figures::default()
-    };
+    let mut tracker = StopTracker::start(&rig);
     // Bound to no session, as an E-stop panel's constant frame.
     let latch = AnyMessage::EStop(EStop::latch(NodeId::Tool))
         .encode(&Session::unjoined(TEST_KEY), 0)
         .unwrap();
     rig.tool_send(&latch).unwrap();
     let end_us = (end_s * 1e6).round() as u64;
-    let mut elapsed_s = 0.0;
+    let mut fell = false;
     while rig.stats().cycles * PERIOD_US < end_us {
         rig.step().unwrap();
-        elapsed_s += PERIOD_US as f64 * 1e-6;
         let record = rig.records().last().unwrap().clone();
-        let torso = rig.sim().physics().torso();
-        let tilt = record.tilt_deg;
-        let drop = -torso.vel_m_s[2];
-        f.fell |= record.fallen();
-        f.reported &=
-            record.state == Some(State::EStop) && record.faults.contains(FaultFlags::ESTOP_LATCHED);
-        let drives_off = record.torque_off.iter().all(|&o| o);
-        let controller_off = record.leg_targets_rad.is_some_and(|(_, enabled)| !enabled)
-            && record.wheel_torque_nm == Some([0.0; 2]);
-        if f.off_after_s.is_none() {
-            f.max_tilt_to_off_deg = f.max_tilt_to_off_deg.max(tilt);
-            f.max_drop_before_off_m_s = f.max_drop_before_off_m_s.max(drop);
-            if f.rest_after_s.is_none() {
-                f.max_tilt_to_rest_deg = f.max_tilt_to_rest_deg.max(tilt);
-            }
-            if drives_off && controller_off {
-                f.off_after_s = Some(elapsed_s);
-            }
-        } else {
-            f.held &= drives_off && controller_off;
-            f.max_drop_after_off_m_s = f.max_drop_after_off_m_s.max(drop);
-            f.max_tilt_after_off_deg = f.max_tilt_after_off_deg.max(tilt);
-        }
-        if f.rest_after_s.is_none() && torso.vel_m_s[0].hypot(torso.vel_m_s[1]) < 0.02 {
-            f.rest_after_s = Some(elapsed_s);
-        }
-        f.final_tilt_deg = tilt;
-        f.height_m[1] = torso.pos_m[2];
+        fell |= record.fallen();
+        tracker.observe(&rig, &record);
     }
-    f
+    Figures {
+        stop: tracker.finish(),
+        fell,
+    }
 }
 
 fn deadline_s() -> f64 {
@@ -111,15 +56,15 @@ fn deadline_s() -> f64 {
 /// fall.
 fn assert_stopped_within_the_deadline(what: &str, f: &Figures) {
     assert!(
-        f.reported,
+        f.stop.reported,
         "{what}: EStop not reported from the latch on: {f:#?}"
     );
-    let off = f.off_after_s.unwrap_or(f64::INFINITY);
+    let off = f.stop.off_after_s.unwrap_or(f64::INFINITY);
     assert!(
         off <= deadline_s() + 1e-9,
         "{what}: torque-free after {off} s: {f:#?}"
     );
-    assert!(f.held, "{what}: a drive came back on: {f:#?}");
+    assert!(f.stop.held, "{what}: a drive came back on: {f:#?}");
     assert!(!f.fell, "{what}: fell: {f:#?}");
 }
 
@@ -132,16 +77,16 @@ fn an_e_stop_at_top_speed_on_the_wheels_brakes_to_rest_and_sets_the_robot_down()
     ];
     let f = estop(plan, 6.0, 6.0 + deadline_s() + 2.5);
     println!("MEASURED E-stop on the wheels at top speed: {f:#?}");
-    assert!(f.speed_at_latch_m_s > 0.45, "not at top speed: {f:#?}");
+    assert!(f.stop.speed_at_latch_m_s > 0.45, "not at top speed: {f:#?}");
     assert_stopped_within_the_deadline("wheels", &f);
-    let rest = f.rest_after_s.unwrap_or(f64::INFINITY);
+    let rest = f.stop.rest_after_s.unwrap_or(f64::INFINITY);
     assert!(rest <= 1.0, "at rest after {rest} s: {f:#?}");
-    assert!(f.max_tilt_to_rest_deg <= 15.0, "{f:#?}");
-    assert!(f.max_drop_after_off_m_s <= 0.3, "{f:#?}");
-    assert!(f.final_tilt_deg <= 20.0, "{f:#?}");
+    assert!(f.stop.max_tilt_to_rest_deg <= 15.0, "{f:#?}");
+    assert!(f.stop.max_drop_after_off_m_s <= 0.3, "{f:#?}");
+    assert!(f.stop.final_tilt_deg <= 20.0, "{f:#?}");
     // Under power, the front legs swing out on their way into the kickstand so that their
     // sweep does not lift the robot off its wheels (1.17 m/s of descent without; 0.30 with).
-    assert!(f.max_drop_before_off_m_s <= 0.35, "{f:#?}");
+    assert!(f.stop.max_drop_before_off_m_s <= 0.35, "{f:#?}");
 }
 
 /// The sit-down from the legs: torque-free by the deadline, no fall, resting on the kickstand
@@ -149,9 +94,9 @@ fn an_e_stop_at_top_speed_on_the_wheels_brakes_to_rest_and_sets_the_robot_down()
 /// 0.3 m/s under power.
 fn assert_sat_down(what: &str, f: &Figures) {
     assert_stopped_within_the_deadline(what, f);
-    assert!(f.max_drop_before_off_m_s <= 0.3, "{what}: {f:#?}");
-    assert!(f.max_drop_after_off_m_s <= 0.3, "{what}: {f:#?}");
-    assert!(f.final_tilt_deg <= 20.0, "{what}: {f:#?}");
+    assert!(f.stop.max_drop_before_off_m_s <= 0.3, "{what}: {f:#?}");
+    assert!(f.stop.max_drop_after_off_m_s <= 0.3, "{what}: {f:#?}");
+    assert!(f.stop.final_tilt_deg <= 20.0, "{what}: {f:#?}");
 }
 
 #[test]

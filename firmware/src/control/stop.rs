@@ -390,35 +390,14 @@ impl Stop {
                 let [ground, turn] = input.speeds_m_s;
                 let rest = self.config.rest_speed_m_s;
                 let at_rest = input.braked && ground.abs() < rest && turn.abs() < rest;
-                let next = ((done && at_rest) || self.kickstand_due(now)).then(|| {
-                    let elapsed = now.since(self.latched);
-                    let spread = self.config.kickstand_spread_rad;
-                    Phase::Kickstand(kickstand_ramp(
-                        &self.config,
-                        self.rate,
-                        pose,
-                        now,
-                        elapsed,
-                        spread,
-                    ))
-                });
+                let next = ((done && at_rest) || self.kickstand_due(now))
+                    .then(|| self.kickstand_from(pose, now, self.config.kickstand_spread_rad));
                 (StopCommand::Servo(pose), next)
             }
             Phase::Rise(ramp) => {
                 let (pose, done) = ramp.at(now);
-                let elapsed = now.since(self.latched);
-                // Slowly as the deadline allows: the descent of the torso scales with it.
                 // No spread: the front feet carry the robot until the wheels take it.
-                let next = done.then(|| {
-                    Phase::Kickstand(kickstand_ramp(
-                        &self.config,
-                        self.rate,
-                        pose,
-                        now,
-                        elapsed,
-                        0.0,
-                    ))
-                });
+                let next = done.then(|| self.kickstand_from(pose, now, 0.0));
                 (StopCommand::Servo(pose), next)
             }
             Phase::Kickstand(ramp) => {
@@ -450,6 +429,14 @@ impl Stop {
     /// stop of category 1 ends torque-free).
     pub fn cut(&self) -> bool {
         self.cut
+    }
+
+    /// The ramp from `pose` into the kickstand started at `now`, as slowly as the deadline
+    /// allows (the torso's descent scales with it), the front legs swung out by `spread_rad`.
+    fn kickstand_from(&self, pose: Joints<f32>, now: Tick, spread_rad: f32) -> Phase {
+        let elapsed = now.since(self.latched);
+        let ramp = kickstand_ramp(&self.config, self.rate, pose, now, elapsed, spread_rad);
+        Phase::Kickstand(ramp)
     }
 
     /// Whether the kickstand must start now to be reached and settled before the deadline

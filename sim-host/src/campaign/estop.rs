@@ -1,6 +1,6 @@
-//! The E-stop scenario's figures, from the latch on: the same ones `tests/estop_ss1.rs` judges
-//! (an SS1 stop: under control to rest, then every drive torque-free by the deadline and ever
-//! after, the stop reported throughout, no fall).
+//! The E-stop's figures, from the latch on, for the campaign's E-stop scenario and
+//! `tests/estop_ss1.rs` alike (an SS1 stop: under control to rest, then every drive torque-free
+//! by the deadline and ever after, the stop reported throughout).
 
 use firmware::control::fsm::State;
 use protocol::FaultFlags;

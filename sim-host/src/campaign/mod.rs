@@ -16,7 +16,7 @@
 
 pub mod draw;
 pub mod error;
-mod estop;
+pub mod estop;
 pub mod imu;
 pub mod judge;
 pub mod observe;
