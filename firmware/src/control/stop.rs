@@ -35,8 +35,8 @@
 //! into the kickstand pose, which sits the torso down onto its wheels and front feet; then
 //! Settle and Off. The first share of that path ([`StopConfig::sit_rise_share`]) lifts the torso
 //! a little rather than lowering it, so it goes at the fastest rate (**Rise**) and the rest of
-//! the deadline goes to the part that lowers it (the torso's fastest descent from a stand was
-//! 0.34 m/s over one ramp; see `sim-host/tests/estop_ss1.rs` for the present figures).
+//! the deadline goes to the part that lowers it (`sim-host/tests/estop_ss1.rs` measures the
+//! descent).
 //!
 //! The front feet pass under the hips on the way to their stops. From the wheels they are
 //! unloaded and swing out sideways on the way ([`StopConfig::kickstand_spread_rad`]), so they
