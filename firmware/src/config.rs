@@ -111,6 +111,8 @@ impl Config {
             pitch_trim_rad: crate::math::deg_to_rad(3.2),
             trim_time_constant_s: 2.0,
             trim_range_rad: crate::math::deg_to_rad(15.0),
+            trim_follow_time_constant_s: 0.1,
+            lean_rad_per_m_s2: BalanceModel::ROBOT.lean_rad_per_m_s2(),
             accel_limit_m_s2: 0.35,
             brake_limit_m_s2: 1.2,
             wheel_viscous_nm_per_rad_s: 2.0,

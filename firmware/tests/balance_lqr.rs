@@ -138,21 +138,33 @@ fn simulate_off_trim(
     seconds: f64,
     trim_error_rad: f32,
 ) -> ((Vec<[f64; 4]>, Vec<f32>), f32) {
+    drive_off_trim(pitch0_rad, |_| velocity_ref_m_s, seconds, trim_error_rad)
+}
+
+/// [`simulate_off_trim`] with the speed reference a function of time, s.
+#[allow(clippy::type_complexity)]
+fn drive_off_trim(
+    pitch0_rad: f64,
+    velocity_ref_m_s: impl Fn(f64) -> f32,
+    seconds: f64,
+    trim_error_rad: f32,
+) -> ((Vec<[f64; 4]>, Vec<f32>), f32) {
     let (a, b) = continuous(&BalanceModel::ROBOT);
     let (ad, bd) = discrete(&a, &b, DT_S);
     let config = Config::ROBOT.balance;
     let mut balance = Balance::new(config);
     balance.set_trim_learning(true);
+    balance.set_trim_following(true);
     let mut x = Matrix4x1::new(0.0, pitch0_rad, 0.0, 0.0);
     let r = BalanceModel::ROBOT.wheel_radius_m as f64;
     let mut states = Vec::new();
     let mut torques = Vec::new();
-    for _ in 0..(seconds / DT_S) as usize {
+    for step in 0..(seconds / DT_S) as usize {
         let input = BalanceInput {
             pitch_rad: x[1] as f32 + config.pitch_trim_rad + trim_error_rad,
             pitch_rate_rad_s: x[3] as f32,
             wheel_rate_rad_s: (x[2] / r - x[3]) as f32,
-            velocity_ref_m_s,
+            velocity_ref_m_s: velocity_ref_m_s(step as f64 * DT_S),
         };
         let torque = balance.update(&input, DT_S as f32);
         torques.push(torque);
@@ -181,6 +193,42 @@ fn learns_a_trim_error_at_rest_and_stops_drifting() {
         });
         assert!(high - low < 0.05, "{error_deg}°: drifted {} m", high - low);
     }
+}
+
+#[test]
+fn learns_a_trim_error_while_driving_and_the_stop_holds_its_place() {
+    // The campaign's X after W: the fold leaves no time at rest, so the trim is learned on the
+    // way. Without it the stop would roll k_θ/k_p · 4° ≈ 0.2 m after the robot came to rest.
+    for error_deg in [4.0_f32, -4.0] {
+        let error_rad = error_deg.to_radians();
+        let reference = |t: f64| if t < 3.0 { 0.48 } else { 0.0 };
+        let ((states, _), learned) = drive_off_trim(0.0, reference, 8.0, error_rad);
+        let expected = Config::ROBOT.balance.pitch_trim_rad + error_rad;
+        assert!(
+            (learned - expected).abs() < 0.2_f32.to_radians(),
+            "{error_deg}°: learned {learned} rad, expected {expected}"
+        );
+        // From a second after the stop's command on, the robot moves less than 5 cm.
+        let tail = &states[(4.0 / DT_S) as usize..];
+        let (low, high) = tail.iter().fold((f64::MAX, f64::MIN), |(lo, hi), s| {
+            (lo.min(s[0]), hi.max(s[0]))
+        });
+        assert!(high - low < 0.05, "{error_deg}°: moved {} m", high - low);
+    }
+}
+
+#[test]
+fn the_lean_per_acceleration_is_the_linear_models() {
+    // Mid-way through the speed reference's ramp the pendulum accelerates steadily; its lean
+    // from the balance point is what the trim following takes out.
+    let config = Config::ROBOT.balance;
+    let (states, _) = simulate(0.0, 0.48, 1.2);
+    let [_, lean_rad, _, _] = states[(1.0 / DT_S) as usize];
+    let expected = config.lean_rad_per_m_s2 as f64 * config.accel_limit_m_s2 as f64;
+    assert!(
+        (lean_rad - expected).abs() < 0.1 * expected,
+        "lean {lean_rad} rad, expected {expected} rad"
+    );
 }
 
 #[test]

@@ -455,6 +455,9 @@ impl Controller {
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
         self.balance
             .set_trim_learning(matches!(self.state, State::Wheels(_)));
+        let tucked = matches!(self.state, State::Folding(_)) && self.fold_done_at.is_some();
+        self.balance
+            .set_trim_following(matches!(self.state, State::Wheels(_)) || tucked);
         let common = self.balance.update(
             &BalanceInput {
                 pitch_rad: self.sensors.attitude.pitch_rad,

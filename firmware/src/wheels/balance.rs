@@ -47,6 +47,16 @@ pub struct BalanceModel {
 }
 
 impl BalanceModel {
+    /// How much more the body leans than its balance point while the axle accelerates
+    /// steadily, rad per m/s²: the body's moment balance about the axle with the wheels'
+    /// ground force and inertia, `(1 + ((m + m_w) r + I_w / r) / (m l)) / g`.
+    pub const fn lean_rad_per_m_s2(&self) -> f32 {
+        let m = self.body_mass_kg;
+        let pushed = (m + self.wheel_mass_kg) * self.wheel_radius_m
+            + self.wheel_inertia_kg_m2 / self.wheel_radius_m;
+        (1.0 + pushed / (m * self.com_height_m)) / crate::control::estimator::GRAVITY_M_S2
+    }
+
     /// The robot at the report's density 600 kg/m³, legs folded: torso box 0.6 × 0.5 × 0.18 m
     /// (32.4 kg, centre 0.15 m above the axle) plus four legs of capsules and a sphere foot
     /// (≈ 0.85 kg each, near the hips); wheels r = 0.12 m, width 0.09 m (2.44 kg each).
@@ -107,11 +117,18 @@ pub struct BalanceConfig {
     /// Pitch at which the body's centre of mass is over the axle, rad (a fold pose that puts
     /// mass behind the hips needs a forward lean): the starting value of the learned trim.
     pub pitch_trim_rad: f32,
-    /// Time constant of the trim learning, s: while the reference is steady and the body
-    /// still, the trim follows the measured pitch this slowly (see [`Balance::pitch_trim_rad`]).
+    /// Time constant of the trim learning from the position error at rest, s (see
+    /// [`Balance::pitch_trim_rad`]).
     pub trim_time_constant_s: f32,
     /// The learned trim stays within this of `pitch_trim_rad`, rad.
     pub trim_range_rad: f32,
+    /// Time constant of the trim's following the balance point the body's steady lean shows,
+    /// s (see [`Balance::pitch_trim_rad`]): short, so that the few tenths of a second of
+    /// steady rolling a fold or a drive gives are enough.
+    pub trim_follow_time_constant_s: f32,
+    /// How much more the body leans than its balance point per m/s² of steady acceleration,
+    /// rad ([`BalanceModel::lean_rad_per_m_s2`]).
+    pub lean_rad_per_m_s2: f32,
     /// The speed reference speeds up at most this fast, m/s²: a step in speed would throw the
     /// pendulum over by the lean it needs to accelerate (about 0.2 rad per m/s² on this robot,
     /// plus the law's overshoot).
@@ -124,6 +141,11 @@ pub struct BalanceConfig {
     /// error (which the robot would make up by overshooting, and give back after a stop).
     pub wheel_viscous_nm_per_rad_s: f32,
 }
+
+/// Ground acceleration below which the trim follows the balance point the lean shows, m/s²
+/// (the acceleration's share of the lean is taken out; beyond this the lean is no longer
+/// steady enough to read).
+const TRIM_FOLLOW_M_S2: f32 = 0.5;
 
 /// Pitch rate below which the body counts as still for the trim learning, rad/s.
 const TRIM_STILL_RAD_S: f32 = 0.05;
@@ -180,6 +202,9 @@ pub struct Balance {
     accel_m_s2: f32,
     /// Whether the trim may be learned now (see [`Balance::set_trim_learning`]).
     learning: bool,
+    /// Whether the trim may follow the balance point now (see
+    /// [`Balance::set_trim_following`]).
+    following: bool,
     /// How long the robot has been at rest, s.
     rest_s: f32,
 }
@@ -196,6 +221,7 @@ impl Balance {
             trim_rad: config.pitch_trim_rad,
             accel_m_s2: 0.0,
             learning: false,
+            following: false,
             rest_s: 0.0,
         }
     }
@@ -205,6 +231,13 @@ impl Balance {
     /// deliberate position error ([`Balance::hold_at`]) or it stands up.
     pub fn set_trim_learning(&mut self, learning: bool) {
         self.learning = learning;
+    }
+
+    /// Lets the trim follow the balance point the lean shows, or not: while the legs are
+    /// folded (the pose the trim belongs to), the fold's return to its start included (a
+    /// deliberate position error does not mislead it).
+    pub fn set_trim_following(&mut self, following: bool) {
+        self.following = following;
     }
 
     /// One step of the trim learning: while the robot is asked to stand, and either has been
@@ -225,14 +258,41 @@ impl Balance {
         }
         // A drift is corrected four times faster: the robot is rolling away meanwhile.
         let tau_s = if drifting { 0.25 * tau_s } else { tau_s };
-        let gain = crate::math::clamp(dt_s / tau_s, 0.0, 1.0);
+        self.take_trim(error_rad, dt_s / tau_s);
+    }
+
+    /// One step of the trim following the balance point: whenever the body's lean is steady
+    /// (it turns slower than [`TRIM_STILL_RAD_S`] and the robot accelerates less than
+    /// [`TRIM_FOLLOW_M_S2`]), the lean is the balance point plus what the acceleration needs
+    /// ([`BalanceConfig::lean_rad_per_m_s2`]), and the trim follows that balance point
+    /// (time constant [`BalanceConfig::trim_follow_time_constant_s`]). It holds at rest, rolling
+    /// and drifting, whatever the wheels' friction (the drive's torque and the friction both act
+    /// between wheel and body and cancel on it). The position error is no measure while rolling:
+    /// it also stands for the friction the feed-forward does not match, which a stop drops. So
+    /// a trim learned before the stop is what lets the stop hold its place.
+    fn follow_balance_point(&mut self, input: &BalanceInput, dt_s: f32) {
+        let steady = input.pitch_rate_rad_s.abs() < TRIM_STILL_RAD_S
+            && self.accel_m_s2.abs() < TRIM_FOLLOW_M_S2;
+        let balance_point_rad = input.pitch_rad - self.config.lean_rad_per_m_s2 * self.accel_m_s2;
+        let error_rad = balance_point_rad - self.trim_rad;
+        let tau_s = self.config.trim_follow_time_constant_s;
+        if self.following && steady && error_rad.is_finite() && tau_s > 0.0 {
+            self.take_trim(error_rad, dt_s / tau_s);
+        }
+    }
+
+    /// Moves the trim by `gain` of `error_rad` (within its range), and the position error by
+    /// as much as keeps the law at the same equilibrium: the robot stays where it is instead
+    /// of rolling back to where its position error was counted from. (Letting the robot roll
+    /// back instead, as a trim that corrects its own error would, measured worse in every
+    /// wheeled scenario of the campaign.)
+    fn take_trim(&mut self, error_rad: f32, gain: f32) {
+        let k = self.config.gains;
+        let gain = crate::math::clamp(gain, 0.0, 1.0);
         let nominal = self.config.pitch_trim_rad;
         let range = self.config.trim_range_rad;
         let learned = self.trim_rad + gain * error_rad;
         let learned = crate::math::clamp(learned, nominal - range, nominal + range);
-        // What the trim takes over, the position error gives up: the law stays at the same
-        // equilibrium, so the robot stays where it is instead of rolling back to where its
-        // position error was counted from.
         let taken_rad = learned - self.trim_rad;
         self.trim_rad = learned;
         self.position_error_m += taken_rad * k.pitch_nm_per_rad / k.position_nm_per_m;
@@ -272,11 +332,17 @@ impl Balance {
     ///
     /// A robot is not its drawing: with the torso's centre of mass 3 cm behind where the model
     /// has it, the fixed trim left the law needing more standing position error than it may
-    /// remember, and the robot rolled away at 0.15 m/s, leaning 14°. While the speed
-    /// robot is asked to stand, quasi-static, and at rest or drifting, the trim integrates the
-    /// trim error that the position error the law holds stands for (time constant
-    /// [`BalanceConfig::trim_time_constant_s`]), and the position error gives up as much: the
-    /// robot stays where it is, and the law ends needing no standing position error.
+    /// remember, and the robot rolled away at 0.15 m/s, leaning 14°. Two rules learn it, and
+    /// what the trim takes over the position error gives up (the robot stays where it is):
+    ///
+    /// - whenever the lean is steady, rolling or at rest, the trim follows the balance point
+    ///   the lean shows, the acceleration's share taken out (time constant
+    ///   [`BalanceConfig::trim_follow_time_constant_s`]): a drive that follows a fold with no
+    ///   rest between learns it on the way, and its stop holds its place;
+    /// - at rest, or drifting at its position-error bound, the trim integrates the trim error
+    ///   that the position error the law holds stands for
+    ///   ([`BalanceConfig::trim_time_constant_s`]), so the law ends needing none.
+    ///
     /// [`Balance::reset`] keeps what was learned.
     pub fn pitch_trim_rad(&self) -> f32 {
         self.trim_rad
@@ -327,6 +393,9 @@ impl Balance {
         };
         let rested = self.rest_s >= TRIM_REST_S;
         self.learn_trim(input, at_rest && rested, at_rest && out_of_authority, dt_s);
+        if input.velocity_ref_m_s == velocity_ref {
+            self.follow_balance_point(input, dt_s);
+        }
         let pitch = input.pitch_rad - self.trim_rad;
         if !(speed_error.is_finite()
             && velocity_ref.is_finite()
