@@ -453,11 +453,7 @@ impl Controller {
             _ => (0.0, 0.0),
         };
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
-        self.balance
-            .set_trim_learning(matches!(self.state, State::Wheels(_)));
-        let tucked = matches!(self.state, State::Folding(_)) && self.fold_done_at.is_some();
-        self.balance
-            .set_trim_following(matches!(self.state, State::Wheels(_)) || tucked);
+        self.set_trim_rules();
         let common = self.balance.update(
             &BalanceInput {
                 pitch_rad: self.sensors.attitude.pitch_rad,

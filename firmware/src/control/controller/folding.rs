@@ -92,6 +92,15 @@ impl Controller {
         }
     }
 
+    /// Which of the balance law's trim rules may learn now: from the position error only on
+    /// the wheels, the following of the balance point also in a fold whose legs are tucked.
+    pub(super) fn set_trim_rules(&mut self) {
+        let wheels = matches!(self.state, State::Wheels(_));
+        let tucked = matches!(self.state, State::Folding(_)) && self.fold_done_at.is_some();
+        self.balance.set_trim_learning(wheels);
+        self.balance.set_trim_following(wheels || tucked);
+    }
+
     /// Scales the wheel torques by how long (`ticks`) the wheels have carried the robot.
     pub(super) fn ramp_in(&self, wheel_torque_nm: &mut [f32; 2], ticks: u32) {
         let ramp_ticks = self.config.rate.ticks_from_ms(WHEEL_RAMP_IN_MS).max(1);
