@@ -440,6 +440,7 @@ impl Controller {
         if !self.sensors.attitude_known(now) {
             return [0.0; 2];
         }
+        self.set_trim_rules();
         let config = &self.config;
         let speed = config.wheel_speed_rad_s * self.teleop.speed_scale;
         let (velocity_ref_m_s, turn_ref_rad_s) = match self.state {
@@ -453,7 +454,6 @@ impl Controller {
             _ => (0.0, 0.0),
         };
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
-        self.set_trim_rules();
         let common = self.balance.update(
             &BalanceInput {
                 pitch_rad: self.sensors.attitude.pitch_rad,
