@@ -174,6 +174,15 @@ fn drive_off_trim(
     ((states, torques), balance.pitch_trim_rad())
 }
 
+/// How far apart the robot's positions lie from `from_s` on, m.
+fn travel_from(states: &[[f64; 4]], from_s: f64) -> f64 {
+    let tail = &states[(from_s / DT_S) as usize..];
+    let (low, high) = tail.iter().fold((f64::MAX, f64::MIN), |(lo, hi), s| {
+        (lo.min(s[0]), hi.max(s[0]))
+    });
+    high - low
+}
+
 #[test]
 fn learns_a_trim_error_at_rest_and_stops_drifting() {
     // An IMU mounted 5° off in pitch (or a centre of mass ~1.3 cm off): the fixed trim would
@@ -187,11 +196,8 @@ fn learns_a_trim_error_at_rest_and_stops_drifting() {
             "{error_deg}°: learned {learned} rad, expected {expected}"
         );
         // Over the last 30 s the robot stays within 5 cm.
-        let tail = &states[(10.0 / DT_S) as usize..];
-        let (low, high) = tail.iter().fold((f64::MAX, f64::MIN), |(lo, hi), s| {
-            (lo.min(s[0]), hi.max(s[0]))
-        });
-        assert!(high - low < 0.05, "{error_deg}°: drifted {} m", high - low);
+        let moved_m = travel_from(&states, 10.0);
+        assert!(moved_m < 0.05, "{error_deg}°: drifted {moved_m} m");
     }
 }
 
@@ -209,11 +215,8 @@ fn learns_a_trim_error_while_driving_and_the_stop_holds_its_place() {
             "{error_deg}°: learned {learned} rad, expected {expected}"
         );
         // From a second after the stop's command on, the robot moves less than 5 cm.
-        let tail = &states[(4.0 / DT_S) as usize..];
-        let (low, high) = tail.iter().fold((f64::MAX, f64::MIN), |(lo, hi), s| {
-            (lo.min(s[0]), hi.max(s[0]))
-        });
-        assert!(high - low < 0.05, "{error_deg}°: moved {} m", high - low);
+        let moved_m = travel_from(&states, 4.0);
+        assert!(moved_m < 0.05, "{error_deg}°: moved {moved_m} m");
     }
 }
 

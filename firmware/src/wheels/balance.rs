@@ -130,8 +130,8 @@ pub struct BalanceConfig {
     /// rad ([`BalanceModel::lean_rad_per_m_s2`]).
     pub lean_rad_per_m_s2: f32,
     /// The speed reference speeds up at most this fast, m/s²: a step in speed would throw the
-    /// pendulum over by the lean it needs to accelerate (about 0.2 rad per m/s² on this robot,
-    /// plus the law's overshoot).
+    /// pendulum over by the lean it needs to accelerate ([`BalanceConfig::lean_rad_per_m_s2`]
+    /// per m/s², plus the law's overshoot).
     pub accel_limit_m_s2: f32,
     /// The speed reference slows down at most this fast, m/s²: higher than the acceleration
     /// limit, so that a stop is quick; the lean it costs is brief.
