@@ -46,6 +46,8 @@ struct TestController {
     services: u32,
     targets_rad: Joints<f32>,
     wheel_torque_nm: [f32; 2],
+    /// Whether the commands ask for torque.
+    enabled: bool,
     plan: Plan,
     extra: Vec<Frame>,
     sent: Vec<Frame>,
@@ -66,6 +68,7 @@ impl TestController {
             services: 0,
             targets_rad: start.leg_joint_rad.map(|a| a as f32),
             wheel_torque_nm: [0.0; 2],
+            enabled: true,
             plan: Plan::Command,
             extra: Vec::new(),
             sent: Vec::new(),
@@ -117,12 +120,17 @@ impl TestController {
             self.bus.send(&frame).unwrap();
         }
         if self.plan == Plan::Command {
+            let enable = if self.enabled {
+                DriveEnable::Enabled
+            } else {
+                DriveEnable::Disabled
+            };
             let legs = self.seal(AnyMessage::LegTargets(LegTargets {
-                enable: DriveEnable::Enabled,
+                enable,
                 position: self.targets_rad.map(Angle::saturating_from_si),
             }));
             let wheels = self.seal(AnyMessage::WheelCommand(WheelCommand {
-                enable: DriveEnable::Enabled,
+                enable,
                 torque: self.wheel_torque_nm.map(Torque::saturating_from_si),
             }));
             for frame in [legs, wheels] {
@@ -414,6 +422,95 @@ fn an_e_stop_frame_lets_the_drives_obey_for_the_ss1_timer_then_stops_them_until_
     for status in ctl.borrow().drive_status {
         assert!(!status.unwrap().flags.contains(DriveFlags::ESTOP));
     }
+}
+
+/// The controller's status in `mode`, sealed by `ctl`.
+fn status_frame(ctl: &Rc<RefCell<TestController>>, mode: protocol::ControllerMode) -> Frame {
+    ctl.borrow_mut()
+        .seal(AnyMessage::ControllerStatus(protocol::ControllerStatus {
+            mode,
+            faults: protocol::FaultFlags::EMPTY,
+            tick: protocol::Tick::from_raw(0).unwrap(),
+            body_height: protocol::BodyHeight::saturating_from_si(0.0),
+            pitch: Angle::saturating_from_si(0.0),
+            roll: Angle::saturating_from_si(0.0),
+            release_token: ReleaseToken::new(1),
+        }))
+}
+
+/// Whether every drive has torque this instant.
+fn all_drive(sim: &Simulator) -> bool {
+    let now = sim.now_us();
+    let hardware = sim.hardware();
+    (hardware.legs().iter().map(|leg| leg.core()))
+        .chain([hardware.wheel().core()])
+        .all(|core| core.authority(now) == Authority::Drive)
+}
+
+/// Whether every drive is torque-free this instant, cut by the E-stop's own rules.
+fn all_refused(sim: &Simulator) -> bool {
+    let now = sim.now_us();
+    let hardware = sim.hardware();
+    (hardware.legs().iter().map(|leg| leg.core()))
+        .chain([hardware.wheel().core()])
+        .all(|core| core.authority(now) == Authority::TorqueOff && core.stop_refused())
+}
+
+#[test]
+fn within_the_ss1_timer_the_drives_take_only_the_controllers_stopping_commands() {
+    // A controller that reports another mode after the latch is not stopping the robot: the
+    // drives cut the torque at once, long before the timer.
+    let (mut sim, mut bus, ctl) = setup();
+    ctl.borrow_mut().wheel_torque_nm = [3.0, 3.0];
+    run(&mut sim, &mut bus, &ctl, 25, |_| {});
+    let latch = ctl
+        .borrow_mut()
+        .seal(AnyMessage::EStop(EStop::latch(NodeId::Tool)));
+    let stopping = status_frame(&ctl, protocol::ControllerMode::EStop);
+    ctl.borrow_mut().extra = vec![latch, stopping];
+    run(&mut sim, &mut bus, &ctl, 20, |_| {});
+    assert!(all_drive(&sim), "a controller in its E-stop is obeyed");
+    let driving = status_frame(&ctl, protocol::ControllerMode::WheelForward);
+    ctl.borrow_mut().extra = vec![driving];
+    run(&mut sim, &mut bus, &ctl, 2, |_| {});
+    assert!(
+        all_refused(&sim),
+        "a controller that drives on is not obeyed"
+    );
+    run(&mut sim, &mut bus, &ctl, 20, |_| {});
+    assert_eq!(sim.hardware().wheel_torque_nm(), [0.0, 0.0]);
+    assert!((0..4).all(|leg| !sim.physics().leg_enabled(leg)));
+
+    // Torque asked back after the controller let go is not a stopping command either.
+    let (mut sim, mut bus, ctl) = setup();
+    ctl.borrow_mut().wheel_torque_nm = [3.0, 3.0];
+    run(&mut sim, &mut bus, &ctl, 25, |_| {});
+    let latch = ctl
+        .borrow_mut()
+        .seal(AnyMessage::EStop(EStop::latch(NodeId::Tool)));
+    ctl.borrow_mut().extra = vec![latch];
+    run(&mut sim, &mut bus, &ctl, 20, |_| {});
+    assert!(all_drive(&sim));
+    ctl.borrow_mut().enabled = false;
+    run(&mut sim, &mut bus, &ctl, 5, |_| {});
+    assert!(!all_drive(&sim), "the controller let go");
+    ctl.borrow_mut().enabled = true;
+    run(&mut sim, &mut bus, &ctl, 20, |_| {});
+    assert!(
+        all_refused(&sim),
+        "torque asked back during the stop is refused"
+    );
+    assert_eq!(sim.hardware().wheel_torque_nm(), [0.0, 0.0]);
+    // Until the clear: a release and the controller's status out of its E-stop.
+    let release = ctl.borrow_mut().seal(AnyMessage::EStop(EStop::release(
+        NodeId::Tool,
+        ReleaseToken::new(1),
+    )));
+    let released = status_frame(&ctl, protocol::ControllerMode::Stop);
+    ctl.borrow_mut().extra = vec![release, released];
+    run(&mut sim, &mut bus, &ctl, 20, |_| {});
+    assert!(all_drive(&sim), "the clear restores the drives");
+    assert_eq!(sim.hardware().wheel_torque_nm(), [3.0, 3.0]);
 }
 
 /// Gyro x over the second half of `cycles` cycles of a robot standing still on `plant`: mean

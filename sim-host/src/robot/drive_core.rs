@@ -8,6 +8,12 @@
 //! goes torque-free whatever it hears, until a clear. A drive that cut at once would tip a
 //! balancing robot over at speed; the timer bounds how long a controller that does not stop it
 //! can keep it moving.
+//!
+//! Within the timer the drive takes only the controller's *stopping* commands: commands while
+//! the controller reports its E-stop. A drive that hears the controller report any other mode
+//! after the latch (without a release: a controller that ignores the latch, or a stale one), or
+//! is told to take its torque back after it was told to let go, goes torque-free at once
+//! (category 0) and stays so until the clear.
 
 use protocol::{
     AnyMessage, ControllerMode, Count, DriveFlags, DriveStatus, EStopAction, EncodeError, Frame,
@@ -47,6 +53,11 @@ pub struct DriveCore {
     /// controller's status shows it left its own (it checks the release's token; a release it
     /// refused leaves the drives latched too).
     release_heard: bool,
+    /// During this E-stop a command was not a stopping one (see the module docs): torque off
+    /// until the clear.
+    stop_refused: bool,
+    /// During this E-stop the controller commanded torque off.
+    let_go: bool,
     rejected: u32,
     commands: u32,
     /// A torque was cut to the rating since the last status.
@@ -64,6 +75,8 @@ impl DriveCore {
             commanded_enable: false,
             estop_since_us: None,
             release_heard: false,
+            stop_refused: false,
+            let_go: false,
             rejected: 0,
             commands: 0,
             saturated: false,
@@ -94,7 +107,10 @@ impl DriveCore {
                 AnyMessage::EStop(estop) => {
                     match estop.action {
                         EStopAction::Latch => {
-                            self.estop_since_us = self.estop_since_us.or(Some(now_us));
+                            if self.estop_since_us.is_none() {
+                                self.estop_since_us = Some(now_us);
+                                self.let_go = !self.commanded_enable;
+                            }
                             self.release_heard = false;
                         }
                         EStopAction::Clear => self.release_heard = self.estop_since_us.is_some(),
@@ -102,9 +118,14 @@ impl DriveCore {
                     None
                 }
                 AnyMessage::ControllerStatus(status) => {
-                    if self.release_heard && status.mode != ControllerMode::EStop {
+                    let stopping = status.mode == ControllerMode::EStop;
+                    if self.release_heard && !stopping {
                         self.estop_since_us = None;
                         self.release_heard = false;
+                        self.stop_refused = false;
+                        self.let_go = false;
+                    } else if self.estop() && !stopping {
+                        self.stop_refused = true;
                     }
                     None
                 }
@@ -122,9 +143,22 @@ impl DriveCore {
         }
     }
 
-    /// Records whether the last valid command asked for torque.
+    /// Records whether the last valid command asked for torque. During an E-stop, torque asked
+    /// back after the controller let go is not a stopping command: the drive stays torque-free.
     pub fn set_commanded_enable(&mut self, enable: bool) {
+        if self.estop() {
+            if enable && self.let_go {
+                self.stop_refused = true;
+            }
+            self.let_go |= !enable;
+        }
         self.commanded_enable = enable;
+    }
+
+    /// Whether this E-stop's rules cut the torque early: the controller did not carry out the
+    /// stop (see the module docs).
+    pub fn stop_refused(&self) -> bool {
+        self.stop_refused
     }
 
     /// Whether no valid command arrived for [`COMMAND_TIMEOUT_US`] (false before the first).
@@ -138,6 +172,7 @@ impl DriveCore {
         if self.last_command_us.is_some()
             && self.commanded_enable
             && !self.ss1_expired(now_us)
+            && !self.stop_refused
             && !self.timed_out(now_us)
         {
             Authority::Drive
