@@ -229,21 +229,42 @@ impl SocketCanBus {
         }
     }
 
-    /// Waits at most `left` for a record; whether one may be there. poll(2) counts whole
-    /// milliseconds: a shorter wait would poll with 0 and spin a core until the deadline, so
-    /// it sleeps instead and then says "look once more".
+    /// Waits at most `left` for a record; whether one may be there (see [`wait_step`]).
     fn wait_readable(&self, left: Duration) -> Result<bool, BusError> {
-        if left < Duration::from_millis(1) {
-            std::thread::sleep(left);
-            return Ok(true);
-        }
+        let timeout = match wait_step(left) {
+            WaitStep::Sleep(wait) => {
+                std::thread::sleep(wait);
+                return Ok(true);
+            }
+            WaitStep::Poll(timeout) => timeout,
+        };
         let mut fds = [PollFd::new(self.socket.as_fd(), PollFlags::POLLIN)];
-        let timeout = PollTimeout::try_from(left).unwrap_or(PollTimeout::MAX);
         match poll(&mut fds, timeout) {
             Ok(ready) => Ok(ready > 0),
             Err(Errno::EINTR) => Ok(true),
             Err(errno) => Err(classify(&self.ifname, errno.into())),
         }
+    }
+}
+
+/// How [`SocketCanBus::recv`] waits for a record with `left` to its deadline.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum WaitStep {
+    /// Sleep this long, then look once more.
+    Sleep(Duration),
+    /// poll(2) the socket with this timeout.
+    Poll(PollTimeout),
+}
+
+/// poll(2) counts whole milliseconds: a wait under one would poll with timeout 0, return at
+/// once and poll again until the deadline, spinning a core. Such a wait sleeps instead (and
+/// then says "look once more"); a longer one polls for its whole milliseconds, never past the
+/// deadline, and the rest is again under a millisecond.
+fn wait_step(left: Duration) -> WaitStep {
+    if left < Duration::from_millis(1) {
+        WaitStep::Sleep(left)
+    } else {
+        WaitStep::Poll(PollTimeout::try_from(left).unwrap_or(PollTimeout::MAX))
     }
 }
 
@@ -297,5 +318,60 @@ mod tests {
         let down = || Err(std::io::Error::from_raw_os_error(100));
         assert!(write_within(Duration::from_secs(10), down).is_err());
         assert!(started.elapsed() < Duration::from_secs(1));
+    }
+    /// How long a wait step takes when no record comes: a sleep its length, a poll its
+    /// timeout.
+    fn spent(step: WaitStep) -> Duration {
+        match step {
+            WaitStep::Sleep(wait) => wait,
+            WaitStep::Poll(timeout) => timeout.duration().unwrap_or(Duration::MAX),
+        }
+    }
+
+    /// Waits from a microsecond to far beyond poll(2)'s range, and around its millisecond.
+    const WAITS: [Duration; 10] = [
+        Duration::from_nanos(1),
+        Duration::from_micros(1),
+        Duration::from_micros(250),
+        Duration::from_nanos(999_999),
+        Duration::from_millis(1),
+        Duration::from_micros(1_500),
+        Duration::from_micros(2_999),
+        Duration::from_millis(20),
+        Duration::from_secs(3),
+        Duration::from_secs(100_000_000),
+    ];
+
+    #[test]
+    fn no_wait_polls_with_a_zero_timeout_or_past_its_deadline() {
+        for left in WAITS {
+            let step = wait_step(left);
+            assert_ne!(step, WaitStep::Poll(PollTimeout::ZERO), "{left:?}");
+            assert!(spent(step) > Duration::ZERO, "{left:?}: {step:?}");
+            assert!(spent(step) <= left, "{left:?}: {step:?}");
+        }
+        assert_eq!(
+            wait_step(Duration::from_micros(300)),
+            WaitStep::Sleep(Duration::from_micros(300))
+        );
+    }
+
+    /// `recv` on a socket that stays empty, on a clock that moves only by what the waits spend
+    /// (a poll with timeout 0 returns at once and costs nothing): the deadline comes after a
+    /// couple of waits. A wait that spends nothing would loop here, as it spun a core for real.
+    #[test]
+    fn a_receive_deadline_is_reached_in_two_waits_at_most_not_by_spinning() {
+        for timeout in WAITS.iter().take(9) {
+            let mut left = *timeout;
+            let mut waits = 0;
+            while !left.is_zero() {
+                waits += 1;
+                assert!(
+                    waits <= 2,
+                    "{timeout:?}: {waits} waits, {left:?} still left"
+                );
+                left -= spent(wait_step(left));
+            }
+        }
     }
 }

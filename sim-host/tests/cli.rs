@@ -1,7 +1,8 @@
 //! `sim-host run` as a user meets it: outputs in `--out`, and errors that say what to do.
 
-use std::path::PathBuf;
-use std::process::Command;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
 
 fn sim_host() -> Command {
     Command::new(env!("CARGO_BIN_EXE_sim-host"))
@@ -166,16 +167,20 @@ fn out_of_range_pace_and_duration_are_usage_errors_not_panics_or_hangs() {
 }
 
 /// The complete lines of a file still being written (a kill can leave half a line).
-fn complete_lines(path: &std::path::Path) -> Vec<String> {
+fn complete_lines(path: &Path) -> Vec<String> {
     let text = std::fs::read_to_string(path).unwrap_or_default();
     let complete = text.rfind('\n').map_or("", |end| &text[..end]);
     complete.lines().map(str::to_owned).collect()
 }
 
-#[test]
-fn a_killed_run_leaves_its_logs_readable_up_to_a_second_before_the_kill() {
-    let out = scratch("killed");
-    let mut child = sim_host()
+/// The simulated time of a telemetry row (its first field), s.
+fn row_time_s(row: &str) -> f64 {
+    row.split(',').next().unwrap().parse().unwrap()
+}
+
+/// A 60 s trot paced at real time, logging into `out`.
+fn paced_run(out: &Path) -> Child {
+    sim_host()
         .args([
             "run",
             "--pace",
@@ -187,35 +192,172 @@ fn a_killed_run_leaves_its_logs_readable_up_to_a_second_before_the_kill() {
             "--no-progress",
         ])
         .arg("--out")
-        .arg(&out)
-        .stdout(std::process::Stdio::null())
-        .stderr(std::process::Stdio::null())
+        .arg(out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
         .spawn()
-        .unwrap();
-    let started = std::time::Instant::now();
-    std::thread::sleep(std::time::Duration::from_secs(4));
+        .unwrap()
+}
+
+/// When `path` appeared, looking every 2 ms for at most `within`.
+fn appeared(path: &Path, within: Duration) -> Instant {
+    let start = Instant::now();
+    while !path.exists() {
+        assert!(
+            start.elapsed() < within,
+            "{} never appeared",
+            path.display()
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    Instant::now()
+}
+
+#[test]
+fn a_run_killed_after_ten_seconds_leaves_its_logs_readable_up_to_a_second_before_the_kill() {
+    let out = scratch("killed");
+    let spawned = Instant::now();
+    let mut child = paced_run(&out);
+    // The logs are created as the simulated clock starts, after the model is loaded: paced at
+    // real time, the simulated time is from then on the wall time since.
+    let created = appeared(&out.join("bus.log"), Duration::from_secs(9));
+    std::thread::sleep(
+        (spawned + Duration::from_secs(10)).saturating_duration_since(Instant::now()),
+    );
     child.kill().unwrap();
-    let killed_after_s = started.elapsed().as_secs_f64();
+    let killed = Instant::now();
     child.wait().unwrap();
-    // Paced to real time, the simulated clock trails the wall clock by the start-up (model
-    // load, under a second); the logs may trail the kill by one flush interval.
-    let least_s = killed_after_s - 1.0 - 1.0;
+    let simulated_at_kill_s = (killed - created).as_secs_f64();
+    // What the run had simulated one wall-clock second before the kill must be on disk.
+    let least_s = simulated_at_kill_s - 1.0;
     let rows = complete_lines(&out.join("telemetry.csv"));
     assert!(rows.len() > 1, "no telemetry on disk");
-    let last_row_s: f64 = rows
-        .last()
-        .unwrap()
-        .split(',')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let last_row_s = row_time_s(rows.last().unwrap());
+    let log = complete_lines(&out.join("bus.log")).join("\n");
+    let frames = host_can::candump::read_log(&(log + "\n")).expect("a readable candump log");
+    let last_frame_s = frames.last().expect("frames on disk").time_s;
+    println!(
+        "MEASURED killed {:.2} s after the start, about {simulated_at_kill_s:.2} s simulated: \
+         telemetry.csv ends at {last_row_s} s, bus.log at {last_frame_s} s",
+        (killed - spawned).as_secs_f64()
+    );
     assert!(
         last_row_s >= least_s,
-        "telemetry ends at {last_row_s} s, killed at {killed_after_s:.2} s"
+        "telemetry ends at {last_row_s} s, killed at about {simulated_at_kill_s:.2} s"
     );
+    assert!(
+        last_frame_s >= least_s,
+        "bus.log ends at {last_frame_s} s, killed at about {simulated_at_kill_s:.2} s"
+    );
+}
+
+/// The figure after `label` in `sim-host run`'s report (`simulated        12.34 s …`).
+fn reported(stdout: &str, label: &str) -> f64 {
+    let line = stdout
+        .lines()
+        .find(|l| l.starts_with(label))
+        .unwrap_or_else(|| panic!("no `{label}` line in\n{stdout}"));
+    line[label.len()..]
+        .split_whitespace()
+        .next()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("no figure in `{line}`"))
+}
+
+#[test]
+fn a_run_sent_sigterm_ends_with_its_logs_complete_up_to_the_signal() {
+    let out = scratch("sigterm");
+    let child = paced_run(&out);
+    appeared(&out.join("bus.log"), Duration::from_secs(10));
+    std::thread::sleep(Duration::from_secs(2));
+    let term = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(term.success());
+    let result = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&result.stdout);
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    // Like Ctrl-C: an orderly end, status 0, saying so.
+    assert_eq!(result.status.code(), Some(0), "{stdout}\n{stderr}");
+    assert!(stdout.contains("interrupted"), "{stdout}");
+    let simulated_s = reported(&stdout, "simulated");
+    let cycles = reported(&stdout, "cycles") as usize;
+    assert!(simulated_s >= 1.0, "{stdout}");
+    // telemetry.csv: whole, one row per simulated cycle, up to the last one.
+    let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    assert!(csv.ends_with('\n'), "telemetry.csv ends mid-row");
+    let lines: Vec<&str> = csv.lines().collect();
+    let columns = lines[0].split(',').count();
+    assert!(lines.iter().all(|l| l.split(',').count() == columns));
+    assert_eq!(lines.len(), cycles + 1, "a header and one row per cycle");
+    let last_row_s = row_time_s(lines.last().unwrap());
+    assert!(
+        (last_row_s - simulated_s).abs() < 0.006,
+        "{last_row_s} vs {stdout}"
+    );
+    // bus.log: whole and readable, up to the last cycle (its frames carry the cycle's start).
     let log = std::fs::read_to_string(out.join("bus.log")).unwrap();
+    assert!(log.ends_with('\n'), "bus.log ends mid-line");
     let frames = host_can::candump::read_log(&log).expect("a readable candump log");
     let last_frame_s = frames.last().expect("frames on disk").time_s;
-    assert!(last_frame_s >= least_s, "bus.log ends at {last_frame_s} s");
+    assert!(
+        last_frame_s >= last_row_s - 0.004 - 1e-9,
+        "bus.log ends at {last_frame_s} s, telemetry at {last_row_s} s"
+    );
+    assert!(std::fs::read(out.join("wheel_torque.png"))
+        .unwrap()
+        .starts_with(b"\x89PNG"));
+}
+
+#[test]
+fn a_run_whose_physics_diverges_leaves_its_logs_up_to_the_failure() {
+    let dir = scratch("diverged");
+    let out = dir.join("out");
+    // MuJoCo logs its warnings to MUJOCO_LOG.TXT in the working directory.
+    std::fs::create_dir_all(&dir).unwrap();
+    // A weight on a spring too stiff for the time step: the state overflows after ~2 s.
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/models/diverging.xml");
+    let result = sim_host()
+        .current_dir(&dir)
+        .args([
+            "run",
+            "--duration-s",
+            "5",
+            "--drive",
+            "0:L",
+            "--no-plots",
+            "--model",
+        ])
+        .arg(&model)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&result.stderr);
+    assert_eq!(result.status.code(), Some(1), "{stderr}");
+    let failed_s: f64 = stderr
+        .split_once("the simulation diverged at t = ")
+        .and_then(|(_, rest)| rest.split_whitespace().next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("no divergence reported: {stderr}"));
+    assert!((1.0..4.0).contains(&failed_s), "{stderr}");
+    // The failing cycle started one period before the failure: the row that ended the cycle
+    // before it, and the frames it sent and heard (logged at its start), are on disk, whole.
+    let last_cycle_s = failed_s - 0.004;
+    let csv = std::fs::read_to_string(out.join("telemetry.csv")).unwrap();
+    assert!(csv.ends_with('\n'), "telemetry.csv ends mid-row");
+    let last_row_s = row_time_s(csv.lines().last().unwrap());
+    assert!(
+        (last_row_s - last_cycle_s).abs() < 1e-6,
+        "telemetry ends at {last_row_s} s, the run failed at {failed_s} s"
+    );
+    let log = std::fs::read_to_string(out.join("bus.log")).unwrap();
+    assert!(log.ends_with('\n'), "bus.log ends mid-line");
+    let frames = host_can::candump::read_log(&log).expect("a readable candump log");
+    let last_frame_s = frames.last().expect("frames on disk").time_s;
+    assert!(
+        (last_frame_s - last_cycle_s).abs() < 1e-6,
+        "bus.log ends at {last_frame_s} s, the run failed at {failed_s} s"
+    );
 }

@@ -72,24 +72,7 @@ fn serve(
             }
         }
         let now = now_ms();
-        let frames = app.poll(now).map_err(TerminalError::Encode)?;
-        let mut errors = Vec::new();
-        for frame in &frames {
-            if let Err(e) = bus.send(frame) {
-                errors.push(format!("send failed: {e}"));
-            }
-        }
-        for _ in 0..crate::MAX_FRAMES_PER_PASS {
-            match bus.recv(Duration::ZERO) {
-                Ok(Some(frame)) => app.observe(now, &frame),
-                Ok(None) => break,
-                Err(e) => {
-                    errors.push(format!("receive failed: {e}"));
-                    break;
-                }
-            }
-        }
-        for error in errors {
+        for error in service_bus(&mut app, bus, now)? {
             if error != last_error {
                 app.note(error.clone());
                 last_error = error;
@@ -113,6 +96,34 @@ fn serve(
         frames_sent: app.frames_sent(),
         estop_latched: app.operator().estop_latched(),
     })
+}
+
+/// One pass's work on the bus at `now_ms`: sends the frames due (an E-stop latch among them),
+/// then reads what came, at most [`crate::MAX_FRAMES_PER_PASS`] frames, so that a bus that
+/// never runs dry cannot keep the loop from the keys. Returns the bus errors met, for the log.
+pub fn service_bus(
+    app: &mut App,
+    bus: &mut dyn Bus,
+    now_ms: u64,
+) -> Result<Vec<String>, TerminalError> {
+    let frames = app.poll(now_ms).map_err(TerminalError::Encode)?;
+    let mut errors = Vec::new();
+    for frame in &frames {
+        if let Err(e) = bus.send(frame) {
+            errors.push(format!("send failed: {e}"));
+        }
+    }
+    for _ in 0..crate::MAX_FRAMES_PER_PASS {
+        match bus.recv(Duration::ZERO) {
+            Ok(Some(frame)) => app.observe(now_ms, &frame),
+            Ok(None) => break,
+            Err(e) => {
+                errors.push(format!("receive failed: {e}"));
+                break;
+            }
+        }
+    }
+    Ok(errors)
 }
 
 /// The key of a terminal event; Ctrl-C is Esc (quit) since raw mode swallows the signal.
