@@ -20,7 +20,7 @@ use crate::output::telemetry_csv::CsvWriter;
 use host_can::candump::{CandumpWriter, LoggedFrame};
 
 /// Longest the logs stay in memory buffers before they are flushed to disk.
-pub const FLUSH_EVERY: Duration = Duration::from_secs(1);
+pub const FLUSH_EVERY: Duration = Duration::from_millis(250);
 
 /// The recorder of one run.
 #[derive(Debug, Default)]
