@@ -76,8 +76,26 @@ fn wrong_length_is_rejected_and_counted() {
         rx.receive(frame.id(), &frame.data()[..8]),
         Err(DecodeError::WrongLength { got: 8, .. })
     ));
-    assert_eq!(rx.counters().get(RejectCause::WrongLength).raw(), 3);
-    assert_eq!(rx.counters().total(), 3);
+    // The E-stop has two lengths, its CAN FD one and the classic 8 bytes: any other is refused
+    // like any frame's, a latch padded longer included.
+    let latch = AnyMessage::EStop(EStop::latch(NodeId::Tool))
+        .encode(&Session::unjoined(TEST_KEY), 0)
+        .unwrap();
+    let mut padded = latch.data().to_vec();
+    padded.resize(64, 0);
+    assert!(matches!(
+        rx.receive(latch.id(), &padded),
+        Err(DecodeError::WrongLength { got: 64, .. })
+    ));
+    // The length is judged first, before the check value: a wrong length is named as such
+    // whatever else is wrong.
+    padded[0] ^= 0xFF;
+    assert!(matches!(
+        rx.receive(latch.id(), &padded),
+        Err(DecodeError::WrongLength { got: 64, .. })
+    ));
+    assert_eq!(rx.counters().get(RejectCause::WrongLength).raw(), 5);
+    assert_eq!(rx.counters().total(), 5);
 }
 
 #[test]
