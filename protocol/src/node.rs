@@ -93,6 +93,11 @@ impl Leg {
     /// The four legs in joint-index order.
     pub const ALL: [Leg; 4] = [Leg::Fl, Leg::Fr, Leg::Bl, Leg::Br];
 
+    /// Whether this is a front leg.
+    pub const fn is_front(self) -> bool {
+        matches!(self, Leg::Fl | Leg::Fr)
+    }
+
     /// Suffix used by the report's joint names (`hip1_fl`).
     pub const fn suffix(self) -> &'static str {
         match self {

@@ -15,6 +15,11 @@ use crate::legs::kinematics::{leg_fk, LegGeometry, LegJoints};
 pub struct LegStance {
     /// The torso-centre height the legs give on flat ground, m.
     pub height_m: f32,
+    /// The torso-centre height the least extended leg gives, m: with all four feet planted,
+    /// the legs that carry the most sag the most, so as the torso settles onto its wheels
+    /// over its front feet this leg is the one still on the ground, and the deepest one is
+    /// already lifting off.
+    pub shallowest_height_m: f32,
     /// The feet's mean position forward of their hips, m (a non-finite foot counts as 0).
     pub mean_foot_x_m: f32,
 }
@@ -48,17 +53,25 @@ impl SupportGeometry {
     /// Where the measured legs put the feet, in one pass of the legs' kinematics.
     pub fn stance_of(&self, geometry: &LegGeometry, joints_rad: &Joints<f32>) -> LegStance {
         let (mut deepest_m, mut sum_x_m): (f32, f32) = (0.0, 0.0);
+        let mut shallowest_m = f32::INFINITY;
         for (_, &angles_rad) in joints_rad.iter_legs() {
             let foot = leg_fk(geometry, &LegJoints::from_array(angles_rad));
             if foot.z_m.is_finite() {
                 deepest_m = deepest_m.max(-foot.z_m);
+                shallowest_m = shallowest_m.min(-foot.z_m);
             }
             if foot.x_m.is_finite() {
                 sum_x_m += foot.x_m;
             }
         }
+        let shallowest_m = if shallowest_m.is_finite() {
+            shallowest_m
+        } else {
+            0.0
+        };
         LegStance {
             height_m: deepest_m + self.foot_radius_m,
+            shallowest_height_m: shallowest_m + self.foot_radius_m,
             mean_foot_x_m: 0.25 * sum_x_m,
         }
     }
@@ -72,5 +85,11 @@ impl SupportGeometry {
     /// Whether legs in `stance` leave the wheels on the ground.
     pub fn grounds_wheels(&self, stance: &LegStance) -> bool {
         stance.height_m <= self.wheel_contact_height_m + self.margin_m
+    }
+
+    /// Whether four planted feet in `stance` have let the torso down onto its wheels: the
+    /// least extended leg, the one carrying, is at the wheels' contact height.
+    pub fn lowered_onto_wheels(&self, stance: &LegStance) -> bool {
+        stance.shallowest_height_m <= self.wheel_contact_height_m + self.margin_m
     }
 }

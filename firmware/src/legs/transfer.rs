@@ -116,8 +116,11 @@ impl Transfer {
         }
     }
 
-    /// The leg targets at `now`, and whether the fold is over.
-    pub fn step(&mut self, now: Tick) -> (Joints<f32>, bool) {
+    /// The leg targets at `now`, and whether the fold is over; `wheels_down`: whether the
+    /// planted feet have let the torso down onto its wheels. The carry ends there: carried on
+    /// past the wheels' touchdown, the legs tipped the torso forward onto its front feet (10°
+    /// and more) and held it there, and the tuck started 0.6 s later.
+    pub fn step(&mut self, now: Tick, wheels_down: bool) -> (Joints<f32>, bool) {
         match self.phase {
             Phase::Settle { ramp, fold } => {
                 let (pose, done) = ramp.at(now);
@@ -131,7 +134,7 @@ impl Transfer {
             }
             Phase::Carry { ramp, fold } => {
                 let (pose, done) = ramp.at(now);
-                if done {
+                if done || wheels_down {
                     let peak = self.config.tuck_rate_rad_s;
                     self.phase = Phase::Tuck(Ramp::new(pose, fold, now, peak, self.rate));
                 }

@@ -55,7 +55,11 @@ impl Controller {
                 )
             }
         };
-        let (pose, done) = transfer.step(now);
+        let wheels_down = {
+            let stance = self.stance();
+            self.config.support.lowered_onto_wheels(&stance)
+        };
+        let (pose, done) = transfer.step(now, wheels_down);
         self.legs_rad = pose;
         self.transfer = Some(transfer);
         if done && self.fold_done_at.is_none() {
