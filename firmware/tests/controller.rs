@@ -41,21 +41,41 @@ fn w_folds_the_legs_through_the_touchdown_pose_then_drives_on_the_wheels() {
     ));
     assert_eq!(bench.state(), folding);
     assert_eq!(output.status.mode, protocol::ControllerMode::Folding);
-    // The legs carry the torso down into the touchdown pose, then tuck into the fold: the
-    // touchdown pose is passed on the way (see `legs::transfer`).
-    let touchdown = CONFIG.transfer.touchdown.to_array();
-    let mut closest_rad = f32::MAX;
+    // The legs carry the torso down toward the touchdown pose until the wheels take it, then
+    // tuck into the fold (see `legs::transfer`): the planted feet let the torso down onto its
+    // wheels on the way, and the tuck starts only then.
+    let support = CONFIG.support;
+    let mut at_tuck = None;
+    let mut last = support.stance_of(&CONFIG.geometry, &bench.joints_rad);
+    let mut back_hip_rad = bench.joints_rad.leg(Leg::Bl)[1];
     let mut ticks = 1;
     while matches!(bench.state(), State::Folding(_)) {
         bench.tick();
         ticks += 1;
-        let off = bench.joints_rad.leg(Leg::Fl).iter().zip(&touchdown);
-        closest_rad = closest_rad.min(off.map(|(a, b)| (a - b).abs()).fold(0.0, f32::max));
+        // The back hips swing forward over the carry and back in the tuck.
+        let now_rad = bench.joints_rad.leg(Leg::Bl)[1];
+        if at_tuck.is_none() && now_rad < back_hip_rad - 1e-6 {
+            at_tuck = Some(last);
+        }
+        back_hip_rad = now_rad;
+        last = support.stance_of(&CONFIG.geometry, &bench.joints_rad);
         assert!(ticks < 2_000, "folding never finished");
     }
+    let at_tuck = at_tuck.expect("the legs never tucked");
     assert!(
-        closest_rad < 1e-3,
-        "never in the touchdown pose: {closest_rad} rad off"
+        support.lowered_onto_wheels(&at_tuck),
+        "the tuck began before the wheels took the robot: {at_tuck:?}"
+    );
+    let touchdown = CONFIG.transfer.touchdown.to_array();
+    assert!(
+        at_tuck.shallowest_height_m
+            > support
+                .stance_of(
+                    &CONFIG.geometry,
+                    &protocol::Joints::from_leg_fn(|_| touchdown)
+                )
+                .height_m,
+        "the carry went on past the wheels' touchdown: {at_tuck:?}"
     );
     // Carried at 0.6 rad/s and tucked at 1.5 rad/s (peaks): a few seconds, not the report's
     // lunge of 0.85 s.

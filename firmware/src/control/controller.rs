@@ -83,9 +83,13 @@ pub struct Controller {
     /// Where the measured legs put the feet, computed at most once a tick (see
     /// [`crate::legs::support`] and [`Controller::wheels_may_drive`]).
     leg_stance: Option<LegStance>,
-    /// The feet's mean position forward of the hips when a fold from the legs began, m
-    /// (`None` otherwise).
+    /// The feet's mean position forward of the hips when a fold's carry began, m (`None`
+    /// otherwise).
     fold_origin_x_m: Option<f32>,
+    /// How far ahead of where it stood the fold has put the robot, m: what the planted feet
+    /// carried it, then what it rolled on its held wheels (see
+    /// [`Controller::carried_forward_m`]).
+    fold_ahead_m: f32,
     /// When the running fold's legs were tucked (`None` before, or with no fold).
     fold_done_at: Option<Tick>,
     /// Ground speed of the wheels last tick, m/s (`None` off the wheels): its change is the
@@ -129,6 +133,7 @@ impl Controller {
             wheels_since: None,
             leg_stance: None,
             fold_origin_x_m: None,
+            fold_ahead_m: 0.0,
             fold_done_at: None,
             last_ground_m_s: None,
         })
@@ -280,6 +285,9 @@ impl Controller {
             let gain = self.config.stop.wheel_hold_nm_per_rad_s;
             let [left, right] = self.sensors.wheel_rate_rad_s;
             wheel_torque_nm = [-gain * left, -gain * right];
+            if matches!(self.state, State::Folding(_)) {
+                self.fold_ahead_m += self.ground_speed_m_s() * dt_s;
+            }
             self.wheels_since = None;
             self.balance.reset();
         } else if self.balancing() && self.armed && self.wheels_may_drive() {
@@ -392,6 +400,7 @@ impl Controller {
             self.transfer = None;
             self.transfer_done = false;
             self.fold_origin_x_m = None;
+            self.fold_ahead_m = 0.0;
             self.fold_done_at = None;
         }
         self.state = next;

@@ -42,6 +42,11 @@ impl Ramp {
         }
     }
 
+    /// Where it starts.
+    pub fn from(&self) -> &Joints<f32> {
+        &self.from
+    }
+
     /// How far along it is at `now`, 0…1 (in time, before the smoothstep).
     pub fn progress(&self, now: Tick) -> f32 {
         let elapsed = now.since(self.start);

@@ -28,7 +28,7 @@
 //! front legs, which saturate and tip the robot over nose first (measured, on ideal and on
 //! rated drives); the report's smoothed stand-up lifts it within the rating.
 
-use protocol::Joints;
+use protocol::{Joints, Leg};
 
 use crate::legs::kinematics::LegJoints;
 use crate::legs::ramp::Ramp;
@@ -47,6 +47,9 @@ pub struct TransferConfig {
     pub carry_rate_rad_s: f32,
     /// Largest joint rate between the touchdown pose and the fold, rad/s.
     pub tuck_rate_rad_s: f32,
+    /// How far the carry moves the legs at the low end of the torso back toward the stance,
+    /// per rad of pitch (see [`Transfer::step`]).
+    pub level_per_rad: f32,
 }
 
 impl TransferConfig {
@@ -62,6 +65,7 @@ impl TransferConfig {
         settle_rate_rad_s: 2.0,
         carry_rate_rad_s: 0.6,
         tuck_rate_rad_s: 2.5,
+        level_per_rad: 4.0,
     };
 
     fn touchdown_pose(&self) -> Joints<f32> {
@@ -74,7 +78,7 @@ impl TransferConfig {
 enum Phase {
     /// Into the stance; the carry and the tuck into `fold` follow.
     Settle { ramp: Ramp, fold: Joints<f32> },
-    /// The carry; the tuck into `fold` follows it.
+    /// The carry from the stance (where its ramp starts); the tuck into `fold` follows it.
     Carry { ramp: Ramp, fold: Joints<f32> },
     /// The tuck.
     Tuck(Ramp),
@@ -116,11 +120,17 @@ impl Transfer {
         }
     }
 
+    /// Whether the feet are still on the ground (settling into the stance or carrying the
+    /// torso down; the tuck not begun).
+    pub fn on_feet(&self) -> bool {
+        matches!(self.phase, Phase::Settle { .. } | Phase::Carry { .. })
+    }
+
     /// The leg targets at `now`, and whether the fold is over; `wheels_down`: whether the
     /// planted feet have let the torso down onto its wheels. The carry ends there: carried on
     /// past the wheels' touchdown, the legs tipped the torso forward onto its front feet (10°
     /// and more) and held it there, and the tuck started 0.6 s later.
-    pub fn step(&mut self, now: Tick, wheels_down: bool) -> (Joints<f32>, bool) {
+    pub fn step(&mut self, now: Tick, wheels_down: bool, pitch_rad: f32) -> (Joints<f32>, bool) {
         match self.phase {
             Phase::Settle { ramp, fold } => {
                 let (pose, done) = ramp.at(now);
@@ -133,7 +143,8 @@ impl Transfer {
                 (pose, false)
             }
             Phase::Carry { ramp, fold } => {
-                let (pose, done) = ramp.at(now);
+                let (planned, done) = ramp.at(now);
+                let pose = self.level(planned, ramp.from(), pitch_rad);
                 if done || wheels_down {
                     let peak = self.config.tuck_rate_rad_s;
                     self.phase = Phase::Tuck(Ramp::new(pose, fold, now, peak, self.rate));
@@ -142,5 +153,23 @@ impl Transfer {
             }
             Phase::Tuck(ramp) => ramp.at(now),
         }
+    }
+
+    /// `planned` with the legs at the low end of the torso moved back toward `stance` by
+    /// `pitch_rad` (the front legs for nose down, the back legs for nose up).
+    fn level(&self, planned: Joints<f32>, stance: &Joints<f32>, pitch_rad: f32) -> Joints<f32> {
+        let share = self.config.level_per_rad * pitch_rad;
+        if !share.is_finite() {
+            return planned;
+        }
+        let (front, back) = (share.clamp(0.0, 1.0), (-share).clamp(0.0, 1.0));
+        let mut pose = planned;
+        for leg in Leg::ALL {
+            let amount = if leg.is_front() { front } else { back };
+            for (angle, target) in pose.leg_mut(leg).iter_mut().zip(stance.leg(leg)) {
+                *angle += amount * (target - *angle);
+            }
+        }
+        pose
     }
 }

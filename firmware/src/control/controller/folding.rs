@@ -59,7 +59,16 @@ impl Controller {
             let stance = self.stance();
             self.config.support.lowered_onto_wheels(&stance)
         };
-        let (pose, done) = transfer.step(now, wheels_down);
+        let pitch_rad = self.sensors.attitude.pitch_rad;
+        let (pose, done) = transfer.step(now, wheels_down, pitch_rad);
+        if let (true, Some(origin_x_m)) = (transfer.on_feet(), self.fold_origin_x_m) {
+            // Counted while the feet are down: the tuck lifts them, and where they are then
+            // says nothing of where the torso went.
+            let ahead_m = origin_x_m - self.stance().mean_foot_x_m;
+            if ahead_m.is_finite() {
+                self.fold_ahead_m = ahead_m;
+            }
+        }
         self.legs_rad = pose;
         self.transfer = Some(transfer);
         if done && self.fold_done_at.is_none() {
@@ -81,16 +90,13 @@ impl Controller {
         (returned && speed_m_s.abs() < FOLD_REST_M_S) || timed_out
     }
 
-    /// How far the torso has moved forward over its planted feet since the fold began, m: the
-    /// mean over the legs of how far each foot went back relative to its hip. The wheels were
-    /// in the air, so the balance law's own odometry did not see it.
-    pub(super) fn carried_forward_m(&mut self) -> f32 {
-        let Some(origin_x_m) = self.fold_origin_x_m else {
-            return 0.0;
-        };
-        let moved_m = origin_x_m - self.stance().mean_foot_x_m;
-        if moved_m.is_finite() {
-            moved_m
+    /// How far the fold has put the robot ahead of where it stood, m: over the carry, the mean
+    /// over the legs of how far each planted foot went back relative to its hip (the wheels
+    /// were in the air, so the balance law's own odometry did not see it); after it, what the
+    /// robot rolled on its held wheels while the feet left the ground.
+    pub(super) fn carried_forward_m(&self) -> f32 {
+        if self.fold_origin_x_m.is_some() && self.fold_ahead_m.is_finite() {
+            self.fold_ahead_m
         } else {
             0.0
         }
