@@ -75,9 +75,9 @@ fn transition(
     }
 }
 
-/// The goal is 5 cm and 8° for every case. Where the fold does not reach it yet (documented in
-/// docs/firmware.md, "Folding in place"), the bound is what it reaches, so that it does not get
-/// worse: `moved_m` and `tilt_deg`.
+/// The goal is 5 cm and 8° for every case. Every fold meets it; where a transition does not
+/// yet (the stand-up's distance, documented in docs/firmware.md, "Folding in place"), the bound
+/// is what it reaches, so that it does not get worse: `moved_m` and `tilt_deg`.
 fn assert_in_place(f: &Figures, moved_m: f64, tilt_deg: f64) {
     println!("MEASURED {}: {f:?} (goal 0.05 m, 8°)", f.what);
     assert!(f.took_s.is_finite(), "never ended: {f:?}");
@@ -92,7 +92,7 @@ const STAND: [(f64, TeleopMode); 2] = [(0.0, TeleopMode::Stop), (0.1, TeleopMode
 #[test]
 fn the_fold_from_standing_happens_in_place() {
     let f = transition("fold from standing", &STAND, TeleopMode::Fold, 1.5);
-    assert_in_place(&f, 0.05, 9.5);
+    assert_in_place(&f, 0.05, 8.0);
 }
 
 #[test]
@@ -102,15 +102,15 @@ fn w_s_and_a_from_standing_fold_in_place() {
         ("S from standing", TeleopMode::WheelBackward),
         ("A from standing", TeleopMode::WheelRotate),
     ] {
-        assert_in_place(&transition(what, &STAND, key, 1.5), 0.05, 9.5);
+        assert_in_place(&transition(what, &STAND, key, 1.5), 0.05, 8.0);
     }
 }
 
 #[test]
 fn the_fold_right_after_a_trot_happens_in_place() {
     for (what, trot, tilt_deg) in [
-        ("fold right after L", TeleopMode::TrotForward, 11.0),
-        ("fold right after K", TeleopMode::TrotBackward, 14.0),
+        ("fold right after L", TeleopMode::TrotForward, 8.0),
+        ("fold right after K", TeleopMode::TrotBackward, 8.0),
     ] {
         let before = [(0.0, TeleopMode::Stop), (0.1, trot)];
         assert_in_place(
@@ -125,5 +125,5 @@ fn the_fold_right_after_a_trot_happens_in_place() {
 fn standing_up_from_the_wheels_happens_in_place() {
     let before = [(0.0, TeleopMode::Stop), (0.1, TeleopMode::Fold)];
     let f = transition("stand-up from the wheels", &before, TeleopMode::Stand, 6.0);
-    assert_in_place(&f, 0.145, 10.0);
+    assert_in_place(&f, 0.145, 8.0);
 }
