@@ -398,23 +398,11 @@ fn an_e_stop_frame_lets_the_drives_obey_for_the_ss1_timer_then_stops_them_until_
     ctl.borrow_mut().extra = vec![release];
     run(&mut sim, &mut bus, &ctl, 30, |_| {});
     assert_eq!(sim.hardware().wheel_torque_nm(), [0.0, 0.0]);
-    let status = |mode| {
-        ctl.borrow_mut()
-            .seal(AnyMessage::ControllerStatus(protocol::ControllerStatus {
-                mode,
-                faults: protocol::FaultFlags::EMPTY,
-                tick: protocol::Tick::from_raw(0).unwrap(),
-                body_height: protocol::BodyHeight::saturating_from_si(0.0),
-                pitch: Angle::saturating_from_si(0.0),
-                roll: Angle::saturating_from_si(0.0),
-                release_token: ReleaseToken::new(1),
-            }))
-    };
-    let still_latched = status(protocol::ControllerMode::EStop);
+    let still_latched = status_frame(&ctl, protocol::ControllerMode::EStop);
     ctl.borrow_mut().extra = vec![still_latched];
     run(&mut sim, &mut bus, &ctl, 5, |_| {});
     assert_eq!(sim.hardware().wheel_torque_nm(), [0.0, 0.0]);
-    let released = status(protocol::ControllerMode::Stop);
+    let released = status_frame(&ctl, protocol::ControllerMode::Stop);
     ctl.borrow_mut().extra = vec![released];
     run(&mut sim, &mut bus, &ctl, 30, |_| {});
     assert_eq!(sim.hardware().wheel_torque_nm(), [3.0, 3.0]);

@@ -173,6 +173,15 @@ fn complete_lines(path: &Path) -> Vec<String> {
     complete.lines().map(str::to_owned).collect()
 }
 
+/// The time of the last frame in `out`'s `bus.log`, which must be whole (ending in a complete
+/// line) and readable, s.
+fn bus_log_end_s(out: &Path) -> f64 {
+    let log = std::fs::read_to_string(out.join("bus.log")).unwrap();
+    assert!(log.ends_with('\n'), "bus.log ends mid-line");
+    let frames = host_can::candump::read_log(&log).expect("a readable candump log");
+    frames.last().expect("frames on disk").time_s
+}
+
 /// The simulated time of a telemetry row (its first field), s.
 fn row_time_s(row: &str) -> f64 {
     row.split(',').next().unwrap().parse().unwrap()
@@ -297,10 +306,7 @@ fn a_run_sent_sigterm_ends_with_its_logs_complete_up_to_the_signal() {
         "{last_row_s} vs {stdout}"
     );
     // bus.log: whole and readable, up to the last cycle (its frames carry the cycle's start).
-    let log = std::fs::read_to_string(out.join("bus.log")).unwrap();
-    assert!(log.ends_with('\n'), "bus.log ends mid-line");
-    let frames = host_can::candump::read_log(&log).expect("a readable candump log");
-    let last_frame_s = frames.last().expect("frames on disk").time_s;
+    let last_frame_s = bus_log_end_s(&out);
     assert!(
         last_frame_s >= last_row_s - 0.004 - 1e-9,
         "bus.log ends at {last_frame_s} s, telemetry at {last_row_s} s"
@@ -352,10 +358,7 @@ fn a_run_whose_physics_diverges_leaves_its_logs_up_to_the_failure() {
         (last_row_s - last_cycle_s).abs() < 1e-6,
         "telemetry ends at {last_row_s} s, the run failed at {failed_s} s"
     );
-    let log = std::fs::read_to_string(out.join("bus.log")).unwrap();
-    assert!(log.ends_with('\n'), "bus.log ends mid-line");
-    let frames = host_can::candump::read_log(&log).expect("a readable candump log");
-    let last_frame_s = frames.last().expect("frames on disk").time_s;
+    let last_frame_s = bus_log_end_s(&out);
     assert!(
         (last_frame_s - last_cycle_s).abs() < 1e-6,
         "bus.log ends at {last_frame_s} s, the run failed at {failed_s} s"

@@ -282,14 +282,7 @@ impl Controller {
             }
         }
         if self.stop.is_some_and(|stop| stop.holds_wheels()) || self.folding_on_feet() {
-            let gain = self.config.stop.wheel_hold_nm_per_rad_s;
-            let [left, right] = self.sensors.wheel_rate_rad_s;
-            wheel_torque_nm = [-gain * left, -gain * right];
-            if matches!(self.state, State::Folding(_)) {
-                self.fold_ahead_m += self.ground_speed_m_s() * dt_s;
-            }
-            self.wheels_since = None;
-            self.balance.reset();
+            wheel_torque_nm = self.hold_wheels(dt_s);
         } else if self.balancing() && self.armed && self.wheels_may_drive() {
             let since = *self.wheels_since.get_or_insert(now);
             if since == now && matches!(self.state, State::Folding(_)) {

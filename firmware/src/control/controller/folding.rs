@@ -111,6 +111,20 @@ impl Controller {
         self.balance.set_trim_following(wheels || tucked);
     }
 
+    /// The wheel torques that hold the wheels still (damped), in a controlled stop or while
+    /// wheels and feet both carry the robot; what a fold rolls meanwhile counts toward how far
+    /// it put the robot ahead.
+    pub(super) fn hold_wheels(&mut self, dt_s: f32) -> [f32; 2] {
+        let gain = self.config.stop.wheel_hold_nm_per_rad_s;
+        let [left, right] = self.sensors.wheel_rate_rad_s;
+        if matches!(self.state, State::Folding(_)) {
+            self.fold_ahead_m += self.ground_speed_m_s() * dt_s;
+        }
+        self.wheels_since = None;
+        self.balance.reset();
+        [-gain * left, -gain * right]
+    }
+
     /// Scales the wheel torques by how long (`ticks`) the wheels have carried the robot.
     pub(super) fn ramp_in(&self, wheel_torque_nm: &mut [f32; 2], ticks: u32) {
         let ramp_ticks = self.config.rate.ticks_from_ms(WHEEL_RAMP_IN_MS).max(1);
