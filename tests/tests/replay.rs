@@ -399,6 +399,51 @@ fn check_replay(what: &str, replayed: &Replayed, expected: (u64, u64), from: Con
     }
 }
 
+/// Slices and pairs of consecutive frames of the candump text `recording` (complete lines),
+/// picked by `seed`: `slices` runs of `slice_len` lines and `pairs` pairs, each at its recorded
+/// spacing, one after the other with 20 ms between them (canplayer keeps a log's timing).
+fn slices_and_pairs(
+    recording: &str,
+    seed: u64,
+    slices: usize,
+    slice_len: usize,
+    pairs: usize,
+) -> String {
+    let lines: Vec<&str> = recording.lines().filter(|l| !l.trim().is_empty()).collect();
+    let time_of = |line: &str| -> f64 {
+        line.trim_start_matches('(')
+            .split(')')
+            .next()
+            .and_then(|t| t.parse().ok())
+            .unwrap_or_else(|| panic!("not a candump -L line: {line}"))
+    };
+    // SplitMix64: the pick repeats on every machine.
+    let mut state = seed;
+    let mut next = |below: usize| {
+        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = state;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) % below as u64) as usize
+    };
+    let mut pieces: Vec<(usize, usize)> = (0..slices)
+        .map(|_| (next(lines.len() - slice_len), slice_len))
+        .collect();
+    pieces.extend((0..pairs).map(|_| (next(lines.len() - 2), 2)));
+    let (mut out, mut clock_s) = (String::new(), 1_000.0_f64);
+    for (start, len) in pieces {
+        let piece = &lines[start..start + len];
+        let first_s = time_of(piece[0]);
+        for line in piece {
+            let rest = line.split_once(')').map_or("", |(_, rest)| rest);
+            let at_s = clock_s + (time_of(line) - first_s);
+            out.push_str(&format!("({at_s:.6}){rest}\n"));
+        }
+        clock_s += time_of(piece[len - 1]) - first_s + 0.02;
+    }
+    out
+}
+
 #[test]
 fn canplayer_replaying_a_whole_session_with_e_stops_into_the_same_controller_releases_and_moves_nothing(
 ) {
@@ -454,26 +499,53 @@ fn canplayer_replaying_a_whole_session_with_e_stops_into_the_same_controller_rel
         "the session has its E-stop and release"
     );
     let expected = expected_refusals(&recording);
+    // Any slice and any pair of consecutive frames: a seeded sample of both, played as one log.
+    let pieces_path = out_dir("pieces-recording").with_extension("log");
+    std::fs::write(&pieces_path, slices_and_pairs(complete, 17, 5, 400, 60)).unwrap();
+    let pieces = read_candump(&pieces_path);
+    let pieces_expected = expected_refusals(&pieces);
+    println!(
+        "slices and pairs: {} frames (5 slices of 400, 60 pairs), {} latches",
+        pieces.len(),
+        pieces.iter().filter(|(_, f)| is_latch(f)).count()
+    );
 
     // Held at STOP, then latched (2.5 s after a fresh latch: the controlled stop is over).
-    let at_stop = bench.replay(&recording_path, "held at STOP");
-    check_replay("held at STOP", &at_stop, expected, ControllerMode::Stop);
-    if at_stop
-        .statuses
-        .last()
-        .is_some_and(|s| s.mode == ControllerMode::EStop)
-    {
-        cansend(&bench.bus, &fresh_release(&bench.frames()));
-        bench.wait_status(at_stop.ticks.1, "re-armed", |s| {
-            s.mode == ControllerMode::Stop
-        });
+    let mut replays = Vec::new();
+    for (what, path, expected) in [
+        ("held at STOP", &recording_path, expected),
+        (
+            "slices and pairs, held at STOP",
+            &pieces_path,
+            pieces_expected,
+        ),
+    ] {
+        let replayed = bench.replay(path, what);
+        check_replay(what, &replayed, expected, ControllerMode::Stop);
+        if replayed
+            .statuses
+            .last()
+            .is_some_and(|s| s.mode == ControllerMode::EStop)
+        {
+            cansend(&bench.bus, &fresh_release(&bench.frames()));
+            bench.wait_status(replayed.ticks.1, "re-armed", |s| {
+                s.mode == ControllerMode::Stop
+            });
+        }
+        replays.push((what, replayed));
     }
     cansend(&bench.bus, &classic_latch(NodeId::Tool, 0).unwrap());
     let now = latest_status(&bench.frames()).unwrap().tick.raw();
     let latched = bench.wait_status(now, "latched again", |s| s.mode == ControllerMode::EStop);
     bench.wait_s(latched, 2.5);
-    let at_estop = bench.replay(&recording_path, "latched");
-    check_replay("latched", &at_estop, expected, ControllerMode::EStop);
+    for (what, path, expected) in [
+        ("latched", &recording_path, expected),
+        ("slices and pairs, latched", &pieces_path, pieces_expected),
+    ] {
+        let replayed = bench.replay(path, what);
+        check_replay(what, &replayed, expected, ControllerMode::EStop);
+        replays.push((what, replayed));
+    }
 
     let (status, _) = sim.interrupt();
     assert!(status.is_some_and(|s| s.success()), "the simulator failed");
@@ -481,7 +553,7 @@ fn canplayer_replaying_a_whole_session_with_e_stops_into_the_same_controller_rel
     let _ = dump.terminate();
     // While each replay ran, the torso stayed where it was (a replayed latch latches a robot
     // held at STOP: its controlled stop is part of the window).
-    for (what, replayed) in [("held at STOP", &at_stop), ("latched", &at_estop)] {
+    for (what, replayed) in &replays {
         let moved = moved_m(&out, replayed.ticks);
         println!("{what}: the torso moved {moved:.3} m while the log replayed");
         assert!(
