@@ -1,12 +1,16 @@
 //! `canplayer` (can-utils) replaying recorded sessions onto a kernel vcan, into the firmware and
 //! the simulator running as two processes: a recorded operator's frames into the controller
 //! restarted in a new session, and a whole recorded bus — every node's frames, E-stop latches
-//! and releases included — into the same controller held at STOP and latched. Nothing releases,
-//! nothing moves, and the nodes refuse and count every replayed frame but the latches.
+//! and releases included — into the same controller held at STOP and latched: the whole log,
+//! then seeded random slices and pairs of consecutive frames of it, played back to back from
+//! one file. Nothing releases, nothing moves, and the nodes refuse and count every replayed
+//! frame but the latches.
 //!
 //! The tests run one at a time: a recording replayed on the wall clock must land in a lockstep
 //! run paced to real time, which a second closed loop beside it (in an emulated VM) would slow.
 
+use std::fmt::Write as _;
+use std::ops::Range;
 use std::path::Path;
 use std::time::Duration;
 
@@ -18,6 +22,8 @@ use protocol::{
     classic_latch, decode_frame, AnyMessage, ControllerMode, ControllerStatus, EStop, EStopAction,
     Frame, MessageId, NodeId, RejectCause, SessionTime,
 };
+use rand::rngs::SmallRng;
+use rand::{Rng, SeedableRng};
 
 /// The firmware (keeping its state in `state`) and the simulator in lockstep, paced to at most
 /// real time (`--pace 1`), so that frames replayed at their recorded wall-clock times land at
@@ -318,9 +324,11 @@ impl Bench {
         self.wait_status(until, "simulated time", |_| true)
     }
 
-    /// Replays the candump text `recording` with `canplayer` (its own timing, onto the bus it
-    /// was recorded on) and waits until the nodes have reported their counters again.
-    fn replay(&self, recording: &Path, what: &str) -> Replayed {
+    /// Replays the candump text at `recording` with `canplayer` (its own timing, onto the bus
+    /// it was recorded on), waits until the nodes have reported their counters again, and
+    /// checks what the replay brought (see [`check_replay`]) against the robot found in `from`.
+    fn replay(&self, recording: &Path, what: &str, from: ControllerMode) -> Replayed {
+        let frames = read_candump(recording);
         let before = counters(&self.frames());
         let start = latest_status(&self.frames()).expect("a status").tick.raw();
         let player = Process::start("canplayer", &["-I", &recording.to_string_lossy()]);
@@ -331,23 +339,60 @@ impl Bench {
         // A second after the last replayed frame, the latest reports are the nodes' own.
         let end = latest_status(&self.frames()).expect("a status").tick.raw();
         self.wait_status(end + 250, what, |_| true);
-        let frames = self.frames();
-        Replayed {
-            refused: refused_between(&before, &counters(&frames)),
-            statuses: statuses_after(&frames, start),
+        let log = self.frames();
+        let replayed = Replayed {
+            frames: frames.len(),
+            playing_s: frames.last().map_or(0.0, |last| last.0 - frames[0].0),
+            refused: refused_between(&before, &counters(&log)),
+            expected: expected_refusals(&frames),
+            statuses: statuses_after(&log, start),
             ticks: (start, end),
+        };
+        check_replay(what, &replayed, from);
+        replayed
+    }
+
+    /// Re-arms the robot if `replayed` left it latched (a replayed latch always acts, by
+    /// design): a fresh release, then half a second for the nodes to report their counters, so
+    /// that the next replay finds it held at STOP again.
+    fn rearm(&self, replayed: &Replayed) {
+        if replayed
+            .statuses
+            .last()
+            .is_some_and(|s| s.mode == ControllerMode::EStop)
+        {
+            cansend(&self.bus, &fresh_release(&self.frames()));
+            let rearmed = self.wait_status(replayed.ticks.1, "re-armed", |s| {
+                s.mode == ControllerMode::Stop
+            });
+            self.wait_s(rearmed, 0.5);
         }
     }
 }
 
 /// What a replay brought.
 struct Replayed {
+    /// Frames replayed.
+    frames: usize,
+    /// How long they took to play at their recorded timing, s.
+    playing_s: f64,
     /// Refusals counted while it ran: (firmware, drives).
     refused: (u64, u64),
+    /// Refusals its frames must bring: (firmware, drives).
+    expected: (u64, u64),
     /// The controller's statuses from its start.
     statuses: Vec<ControllerStatus>,
     /// The controller's ticks when it started and when its last frame had gone.
     ticks: (u32, u32),
+}
+
+impl Replayed {
+    /// The index of the first status that says EStop, if any.
+    fn latched_at(&self) -> Option<usize> {
+        self.statuses
+            .iter()
+            .position(|s| s.mode == ControllerMode::EStop)
+    }
 }
 
 /// How far the torso moved horizontally, m, between `ticks` (simulated time).
@@ -365,7 +410,7 @@ fn moved_m(out: &Path, ticks: (u32, u32)) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// The refusals `recording` must bring when replayed whole: (firmware, drives).
+/// The refusals `recording` must bring when replayed: (firmware, drives).
 fn expected_refusals(recording: &[(f64, Frame)]) -> (u64, u64) {
     recording
         .iter()
@@ -373,25 +418,23 @@ fn expected_refusals(recording: &[(f64, Frame)]) -> (u64, u64) {
         .fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1))
 }
 
-/// Checks one whole-log replay: every frame but the latches refused and counted, and — from
-/// the first status that says EStop on — never released.
-fn check_replay(what: &str, replayed: &Replayed, expected: (u64, u64), from: ControllerMode) {
-    let refused = replayed.refused;
+/// Checks one replay: every frame but the latches refused and counted, and — from the first
+/// status that says EStop on — never released.
+fn check_replay(what: &str, replayed: &Replayed, from: ControllerMode) {
+    let (refused, expected) = (replayed.refused, replayed.expected);
     let modes: Vec<ControllerMode> = replayed.statuses.iter().map(|s| s.mode).collect();
-    let latched = modes.iter().position(|m| *m == ControllerMode::EStop);
-    println!(
-        "{what}: refused (firmware, drives) {refused:?}, expected {expected:?}; latched by the \
-         replay at status {latched:?} of {}",
-        modes.len()
+    assert_eq!(
+        refused, expected,
+        "{what}: refusals (firmware, drives) of {} frames",
+        replayed.frames
     );
-    assert_eq!(refused, expected, "{what}: refusals (firmware, drives)");
     assert!(
         modes
             .iter()
             .all(|m| *m == from || *m == ControllerMode::EStop),
         "{what}: the controller left {from:?}: {modes:?}"
     );
-    if let Some(at) = latched {
+    if let Some(at) = replayed.latched_at() {
         assert!(
             modes[at..].iter().all(|m| *m == ControllerMode::EStop),
             "{what}: released by the replay"
@@ -399,53 +442,84 @@ fn check_replay(what: &str, replayed: &Replayed, expected: (u64, u64), from: Con
     }
 }
 
-/// Slices and pairs of consecutive frames of the candump text `recording` (complete lines),
-/// picked by `seed`: `slices` runs of `slice_len` lines and `pairs` pairs, each at its recorded
-/// spacing, one after the other with 20 ms between them (canplayer keeps a log's timing).
-fn slices_and_pairs(
-    recording: &str,
+/// Seeded random slices of the recording replayed together: this many slices …
+const SLICES: usize = 5;
+/// … of 100 to this many frames …
+const SLICE_MAX: usize = 400;
+/// … and this many pairs of consecutive frames, besides the pairs on either side of every
+/// E-stop frame.
+const PAIRS: usize = 50;
+/// Silence between two pieces as `canplayer` plays them, s (10 control periods).
+const GAP_S: f64 = 0.04;
+
+/// The pieces of a recording of `len` frames to replay (`is_estop`, `is_latch`: whether frame
+/// `i` is an E-stop frame, a latch): seeded random slices and pairs of consecutive frames and
+/// the pairs on either side of every E-stop frame. A replayed latch latches a robot held at
+/// STOP, so the pieces holding one go last and the others find the robot as it was.
+fn pieces(
+    len: usize,
+    is_estop: impl Fn(usize) -> bool,
+    is_latch: impl Fn(usize) -> bool,
     seed: u64,
-    slices: usize,
-    slice_len: usize,
-    pairs: usize,
-) -> String {
-    let lines: Vec<&str> = recording.lines().filter(|l| !l.trim().is_empty()).collect();
-    let time_of = |line: &str| -> f64 {
-        line.trim_start_matches('(')
-            .split(')')
-            .next()
-            .and_then(|t| t.parse().ok())
-            .unwrap_or_else(|| panic!("not a candump -L line: {line}"))
-    };
-    // SplitMix64: the pick repeats on every machine.
-    let mut state = seed;
-    let mut next = |below: usize| {
-        state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = state;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) % below as u64) as usize
-    };
-    let mut pieces: Vec<(usize, usize)> = (0..slices)
-        .map(|_| (next(lines.len() - slice_len), slice_len))
+) -> Vec<Range<usize>> {
+    let mut rng = SmallRng::seed_from_u64(seed);
+    let mut pieces: Vec<Range<usize>> = (0..SLICES)
+        .map(|_| {
+            let start = rng.random_range(0..len - SLICE_MAX);
+            start..start + rng.random_range(100..=SLICE_MAX)
+        })
         .collect();
-    pieces.extend((0..pairs).map(|_| (next(lines.len() - 2), 2)));
-    let (mut out, mut clock_s) = (String::new(), 1_000.0_f64);
-    for (start, len) in pieces {
-        let piece = &lines[start..start + len];
-        let first_s = time_of(piece[0]);
-        for line in piece {
-            let rest = line.split_once(')').map_or("", |(_, rest)| rest);
-            let at_s = clock_s + (time_of(line) - first_s);
-            out.push_str(&format!("({at_s:.6}){rest}\n"));
+    pieces.extend((0..PAIRS).map(|_| {
+        let start = rng.random_range(0..len - 1);
+        start..start + 2
+    }));
+    pieces.extend(
+        (1..len - 1)
+            .filter(|i| is_estop(*i))
+            .flat_map(|i| [i - 1..i + 1, i..i + 2]),
+    );
+    pieces.sort_by_key(|piece| piece.clone().any(&is_latch));
+    pieces
+}
+
+/// Writes pieces of the recording (`text`, its `candump -L` lines) to `path` as one input of
+/// `canplayer`: each piece at its recorded timing (a pair as two consecutive frames), the
+/// next [`GAP_S`] after its last frame. Returns a description of what it holds.
+fn compose(text: &str, seed: u64, path: &Path) -> String {
+    let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+    let recording = host_can::candump::read_log(text).expect("the recording reads back");
+    assert_eq!(recording.len(), lines.len(), "one frame per line");
+    let micros = |time_s: f64| (time_s * 1e6).round() as u64;
+    let frame = |i: usize| &recording[i].frame;
+    let is_latch_at = |i: usize| is_latch(frame(i));
+    let is_estop_at = |i: usize| frame(i).id() == MessageId::EStop.raw();
+    let chosen = pieces(recording.len(), is_estop_at, is_latch_at, seed);
+    let mut out = String::new();
+    let mut at = micros(recording[0].time_s);
+    for piece in &chosen {
+        let first = micros(recording[piece.start].time_s);
+        for i in piece.clone() {
+            let time = at + micros(recording[i].time_s).saturating_sub(first);
+            let (_, rest) = lines[i].split_once(')').expect("a candump line");
+            writeln!(out, "({}.{:06}){rest}", time / 1_000_000, time % 1_000_000).unwrap();
         }
-        clock_s += time_of(piece[len - 1]) - first_s + 0.02;
+        at += micros(recording[piece.end - 1].time_s).saturating_sub(first) + micros(GAP_S);
     }
-    out
+    std::fs::write(path, out).unwrap();
+    let slices: usize = chosen.iter().filter(|p| p.len() > 2).map(Range::len).sum();
+    let latches = chosen
+        .iter()
+        .filter(|&p| p.clone().any(is_latch_at))
+        .count();
+    format!(
+        "{} slices ({slices} frames) and {} pairs (seed {seed}; {latches} pieces with the latch)",
+        chosen.iter().filter(|p| p.len() > 2).count(),
+        chosen.iter().filter(|p| p.len() <= 2).count(),
+    )
 }
 
 #[test]
-fn canplayer_replaying_a_whole_session_with_e_stops_into_the_same_controller_releases_and_moves_nothing(
+fn canplayer_replaying_a_session_with_e_stops_whole_in_slices_and_in_pairs_into_the_same_controller_releases_and_moves_nothing(
 ) {
     let _alone = one_at_a_time();
     let bus = Vcan::new();
@@ -457,11 +531,12 @@ fn canplayer_replaying_a_whole_session_with_e_stops_into_the_same_controller_rel
     let state = bench.bus.state_file();
     // The session: W (the robot folds and drives), an E-stop from a shell, its release, then
     // STOP from 7 s (the operator's W is held through the release: the interlock holds it).
+    // The simulator runs until interrupted after the last replay.
     let (fw, sim) = lockstep_pair(
         &bench.bus,
         &state,
         &out,
-        "60",
+        "120",
         &["--drive", "0:W", "--drive", "7:X"],
     );
     let driving = bench.wait_status(0, "driving", |s| s.mode == ControllerMode::WheelForward);
@@ -477,7 +552,8 @@ fn canplayer_replaying_a_whole_session_with_e_stops_into_the_same_controller_rel
         |s| s.mode == ControllerMode::Stop,
     );
 
-    // The recording: the whole bus so far.
+    // The recording: the whole bus so far; and from it, for each target, one input of
+    // seeded random slices and pairs of consecutive frames played back to back.
     let text = std::fs::read_to_string(&bench.log).unwrap();
     let complete = text.rfind('\n').map_or("", |end| &text[..=end]);
     let recording_path = out_dir("whole-recording").with_extension("log");
@@ -486,7 +562,7 @@ fn canplayer_replaying_a_whole_session_with_e_stops_into_the_same_controller_rel
     let latches = recording.iter().filter(|(_, f)| is_latch(f)).count();
     let releases = recording
         .iter()
-        .filter(|(_, f)| f.id() == 0 && !is_latch(f))
+        .filter(|(_, f)| f.id() == MessageId::EStop.raw() && !is_latch(f))
         .count();
     println!(
         "recorded {} frames over {:.1} s: {latches} latch, {releases} release; held at STOP from \
@@ -498,52 +574,29 @@ fn canplayer_replaying_a_whole_session_with_e_stops_into_the_same_controller_rel
         latches >= 1 && releases >= 1,
         "the session has its E-stop and release"
     );
-    let expected = expected_refusals(&recording);
-    // Any slice and any pair of consecutive frames: a seeded sample of both, played as one log.
-    let pieces_path = out_dir("pieces-recording").with_extension("log");
-    std::fs::write(&pieces_path, slices_and_pairs(complete, 17, 5, 400, 60)).unwrap();
-    let pieces = read_candump(&pieces_path);
-    let pieces_expected = expected_refusals(&pieces);
-    println!(
-        "slices and pairs: {} frames (5 slices of 400, 60 pairs), {} latches",
-        pieces.len(),
-        pieces.iter().filter(|(_, f)| is_latch(f)).count()
-    );
+    let [at_stop, at_estop] = [1, 2].map(|seed| {
+        let path = out_dir(&format!("pieces-{seed}")).with_extension("log");
+        let holds = compose(complete, seed, &path);
+        (path, holds)
+    });
+    let whole = (recording_path.clone(), "the whole log".to_owned());
 
-    // Held at STOP, then latched (2.5 s after a fresh latch: the controlled stop is over).
+    // Held at STOP, then latched (2.5 s after a fresh latch: the controlled stop is over):
+    // each time the whole log, then slices and pairs.
     let mut replays = Vec::new();
-    for (what, path, expected) in [
-        ("held at STOP", &recording_path, expected),
-        (
-            "slices and pairs, held at STOP",
-            &pieces_path,
-            pieces_expected,
-        ),
-    ] {
-        let replayed = bench.replay(path, what);
-        check_replay(what, &replayed, expected, ControllerMode::Stop);
-        if replayed
-            .statuses
-            .last()
-            .is_some_and(|s| s.mode == ControllerMode::EStop)
-        {
-            cansend(&bench.bus, &fresh_release(&bench.frames()));
-            bench.wait_status(replayed.ticks.1, "re-armed", |s| {
-                s.mode == ControllerMode::Stop
-            });
-        }
+    for (path, holds) in [whole.clone(), at_stop] {
+        let what = format!("held at STOP, {holds}");
+        let replayed = bench.replay(&path, &what, ControllerMode::Stop);
+        bench.rearm(&replayed);
         replays.push((what, replayed));
     }
     cansend(&bench.bus, &classic_latch(NodeId::Tool, 0).unwrap());
     let now = latest_status(&bench.frames()).unwrap().tick.raw();
     let latched = bench.wait_status(now, "latched again", |s| s.mode == ControllerMode::EStop);
     bench.wait_s(latched, 2.5);
-    for (what, path, expected) in [
-        ("latched", &recording_path, expected),
-        ("slices and pairs, latched", &pieces_path, pieces_expected),
-    ] {
-        let replayed = bench.replay(path, what);
-        check_replay(what, &replayed, expected, ControllerMode::EStop);
+    for (path, holds) in [whole, at_estop] {
+        let what = format!("latched, {holds}");
+        let replayed = bench.replay(&path, &what, ControllerMode::EStop);
         replays.push((what, replayed));
     }
 
@@ -553,9 +606,24 @@ fn canplayer_replaying_a_whole_session_with_e_stops_into_the_same_controller_rel
     let _ = dump.terminate();
     // While each replay ran, the torso stayed where it was (a replayed latch latches a robot
     // held at STOP: its controlled stop is part of the window).
-    for (what, replayed) in &replays {
-        let moved = moved_m(&out, replayed.ticks);
-        println!("{what}: the torso moved {moved:.3} m while the log replayed");
+    let moved: Vec<f64> = replays
+        .iter()
+        .map(|(_, r)| moved_m(&out, r.ticks))
+        .collect();
+    for ((what, replayed), moved) in replays.iter().zip(&moved) {
+        println!(
+            "MEASURED vcan canplayer, {what}: {} frames over {:.1} s; refused (firmware, drives) \
+             {:?}, expected {:?}; latched by the replay at status {:?} of {}, never released; \
+             the torso moved {moved:.3} m",
+            replayed.frames,
+            replayed.playing_s,
+            replayed.refused,
+            replayed.expected,
+            replayed.latched_at(),
+            replayed.statuses.len(),
+        );
+    }
+    for ((what, _), moved) in replays.iter().zip(moved) {
         assert!(
             moved <= 0.02,
             "{what}: the replay moved the robot {moved:.3} m"
