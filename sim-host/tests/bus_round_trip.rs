@@ -444,18 +444,28 @@ fn all_refused(sim: &Simulator) -> bool {
         .all(|core| core.authority(now) == Authority::TorqueOff && core.stop_refused())
 }
 
-#[test]
-fn within_the_ss1_timer_the_drives_take_only_the_controllers_stopping_commands() {
-    // A controller that reports another mode after the latch is not stopping the robot: the
-    // drives cut the torque at once, long before the timer.
+/// The drives obeying a controller that asks for 3 N·m on each wheel, 25 cycles in; the
+/// simulator, its bus and the controller.
+fn driving() -> (Simulator, InprocEndpoint, Rc<RefCell<TestController>>) {
     let (mut sim, mut bus, ctl) = setup();
     ctl.borrow_mut().wheel_torque_nm = [3.0, 3.0];
     run(&mut sim, &mut bus, &ctl, 25, |_| {});
-    let latch = ctl
-        .borrow_mut()
-        .seal(AnyMessage::EStop(EStop::latch(NodeId::Tool)));
+    (sim, bus, ctl)
+}
+
+/// An E-stop latch from a tool, sealed by `ctl`.
+fn latch_frame(ctl: &Rc<RefCell<TestController>>) -> Frame {
+    ctl.borrow_mut()
+        .seal(AnyMessage::EStop(EStop::latch(NodeId::Tool)))
+}
+
+#[test]
+fn within_the_ss1_timer_a_controller_that_reports_another_mode_is_not_obeyed() {
+    // A controller that reports another mode after the latch is not stopping the robot: the
+    // drives cut the torque at once, long before the timer.
+    let (mut sim, mut bus, ctl) = driving();
     let stopping = status_frame(&ctl, protocol::ControllerMode::EStop);
-    ctl.borrow_mut().extra = vec![latch, stopping];
+    ctl.borrow_mut().extra = vec![latch_frame(&ctl), stopping];
     run(&mut sim, &mut bus, &ctl, 20, |_| {});
     assert!(all_drive(&sim), "a controller in its E-stop is obeyed");
     let driving = status_frame(&ctl, protocol::ControllerMode::WheelForward);
@@ -468,15 +478,12 @@ fn within_the_ss1_timer_the_drives_take_only_the_controllers_stopping_commands()
     run(&mut sim, &mut bus, &ctl, 20, |_| {});
     assert_eq!(sim.hardware().wheel_torque_nm(), [0.0, 0.0]);
     assert!((0..4).all(|leg| !sim.physics().leg_enabled(leg)));
+}
 
-    // Torque asked back after the controller let go is not a stopping command either.
-    let (mut sim, mut bus, ctl) = setup();
-    ctl.borrow_mut().wheel_torque_nm = [3.0, 3.0];
-    run(&mut sim, &mut bus, &ctl, 25, |_| {});
-    let latch = ctl
-        .borrow_mut()
-        .seal(AnyMessage::EStop(EStop::latch(NodeId::Tool)));
-    ctl.borrow_mut().extra = vec![latch];
+#[test]
+fn within_the_ss1_timer_torque_asked_back_after_the_controller_let_go_is_refused_until_the_clear() {
+    let (mut sim, mut bus, ctl) = driving();
+    ctl.borrow_mut().extra = vec![latch_frame(&ctl)];
     run(&mut sim, &mut bus, &ctl, 20, |_| {});
     assert!(all_drive(&sim));
     ctl.borrow_mut().enabled = false;
