@@ -319,6 +319,7 @@ mod tests {
         assert!(write_within(Duration::from_secs(10), down).is_err());
         assert!(started.elapsed() < Duration::from_secs(1));
     }
+
     /// How long a wait step takes when no record comes: a sleep its length, a poll its
     /// timeout.
     fn spent(step: WaitStep) -> Duration {

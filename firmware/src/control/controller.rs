@@ -83,8 +83,8 @@ pub struct Controller {
     /// Where the measured legs put the feet, computed at most once a tick (see
     /// [`crate::legs::support`] and [`Controller::wheels_may_drive`]).
     leg_stance: Option<LegStance>,
-    /// The feet's mean position forward of the hips when a fold's carry began, m (`None`
-    /// otherwise).
+    /// The feet's mean position forward of the hips when a fold from the legs began, m
+    /// (`None` otherwise).
     fold_origin_x_m: Option<f32>,
     /// How far ahead of where it stood the fold has put the robot, m: what the planted feet
     /// carried it, then what it rolled on its held wheels (see

@@ -17,9 +17,10 @@
 //! 0. **Settle** — from a trot, the feet come down under the hips into the stance first, so
 //!    that all four are planted before they carry the torso (folding straight from mid-stride,
 //!    a foot still in the air landed late and the robot ran backward a metre).
-//! 1. **Carry** — the planted feet carry the torso down into the touchdown pose, slowly
+//! 1. **Carry** — the planted feet carry the torso down toward the touchdown pose, slowly
 //!    ([`TransferConfig::carry_rate_rad_s`]): the torso moves forward over the feet as it
-//!    sinks, and the wheels take it as it reaches their contact height.
+//!    sinks, levelled by the legs at its low end ([`TransferConfig::level_per_rad`]), and the
+//!    carry ends where the wheels take it, at the latest in the touchdown pose.
 //! 2. **Tuck** — the legs, unloaded, lift into the fold ([`TransferConfig::tuck_rate_rad_s`])
 //!    while the balance law holds the robot on its wheels.
 //!
@@ -48,7 +49,7 @@ pub struct TransferConfig {
     /// Largest joint rate between the touchdown pose and the fold, rad/s.
     pub tuck_rate_rad_s: f32,
     /// How far the carry moves the legs at the low end of the torso back toward the stance,
-    /// per rad of pitch (see [`Transfer::step`]).
+    /// as a share of the way per rad of pitch (see [`Transfer::step`]).
     pub level_per_rad: f32,
 }
 
@@ -126,10 +127,17 @@ impl Transfer {
         matches!(self.phase, Phase::Settle { .. } | Phase::Carry { .. })
     }
 
-    /// The leg targets at `now`, and whether the fold is over; `wheels_down`: whether the
-    /// planted feet have let the torso down onto its wheels. The carry ends there: carried on
-    /// past the wheels' touchdown, the legs tipped the torso forward onto its front feet (10°
-    /// and more) and held it there, and the tuck started 0.6 s later.
+    /// The leg targets at `now`, and whether the fold is over.
+    ///
+    /// `wheels_down`: whether the planted feet have let the torso down onto its wheels. The
+    /// carry ends there: carried on past the wheels' touchdown, the legs tipped the torso
+    /// forward onto its front feet (10° and more) and held it there, and the tuck started
+    /// 0.6 s later.
+    ///
+    /// `pitch_rad`: the torso's pitch, positive nose down. The feet behind the hips put most of
+    /// the weight on the front legs, whose servos sag more and tip the torso nose down as it
+    /// sinks; the carry keeps the legs at its low end that share nearer the stance
+    /// ([`TransferConfig::level_per_rad`] per rad), so that the wheels take it level.
     pub fn step(&mut self, now: Tick, wheels_down: bool, pitch_rad: f32) -> (Joints<f32>, bool) {
         match self.phase {
             Phase::Settle { ramp, fold } => {
