@@ -40,9 +40,24 @@
 //! reads at rest (its offsets move that by a few per cent: tracked slowly while the torso does
 //! not turn) and falls to 0 at [`EstimatorConfig::accel_distrust`] (impacts, a trot's bounce),
 //! and it falls likewise while the torso turns faster than
-//! [`EstimatorConfig::turn_trust_rad_s`]. An acceleration nobody told the filter and that
+//! [`EstimatorConfig::turn_trust_rad_s`] (on the wheels, only its tilting counts: see
+//! "Spinning"). An acceleration nobody told the filter and that
 //! keeps `|a|` near g (a push on the legs) leans the estimate toward `atan(a/g)` with the
 //! crossover's time constant.
+//!
+//! # Spinning
+//!
+//! What the filter converges to at rest carries the chip's accelerometer offset, an error fixed
+//! to the body (the balance law's learned trim takes up its pitch share), and the share of the
+//! gyro bias not yet learned. A spin in place on the wheels would turn that error with the
+//! body if the gyro carried the estimate alone: a roll error of 3° becomes a pitch error of 3°
+//! after a quarter turn, which the balance law rolls 15 cm to hold (measured in the campaign's
+//! `A`). So on the wheels the spin about "up" does not count as turning for `w` (its
+//! accelerations are in `a_own`), and `k_p` grows by [`EstimatorConfig::spin_kp_per_rad`] per
+//! rad/s of spin beyond [`EstimatorConfig::turn_trust_rad_s`] (so that nothing changes while
+//! the robot does not spin): at the on-the-spot turn's 2 rad/s the crossover is 6.5 rad/s,
+//! fast against the turn, so the estimate stays where the accelerometer puts it, error and
+//! all, as the trim expects.
 //!
 //! # Start-up
 //!
@@ -128,6 +143,10 @@ pub struct EstimatorConfig {
     pub max_gap_ms: u32,
     /// The IMU's height above the wheel axle, along body z, m (its lever arm on the wheels).
     pub imu_above_axle_m: f32,
+    /// On the wheels, the accelerometer correction grows by this per rad/s of spin about
+    /// "up" beyond [`EstimatorConfig::turn_trust_rad_s`], 1/rad (see the module docs,
+    /// "Spinning").
+    pub spin_kp_per_rad: f32,
     /// Time constant of the low-pass on the accelerometer's gravity share, s (40 ms, a
     /// thirtieth of the crossover's: the wheels' speed and the IMU's reading do not line up
     /// sample by sample, and their difference's jitter would fail the `|a|` test).
@@ -156,6 +175,7 @@ impl EstimatorConfig {
         bias_limit_rad_s: 0.1,
         max_gap_ms: 100,
         imu_above_axle_m: 0.15,
+        spin_kp_per_rad: 3.0,
         accel_filter_s: 0.04,
     };
 }
@@ -280,6 +300,12 @@ impl AttitudeEstimator {
         } else {
             (config.kp_per_s, config.ki_per_s2)
         };
+        let kp = if motion.on_wheels {
+            let spin_rad_s = dot(rate, up).abs() - config.turn_trust_rad_s;
+            kp + config.spin_kp_per_rad * spin_rad_s.max(0.0)
+        } else {
+            kp
+        };
         let (step, limit) = (ki * dt_s, config.bias_limit_rad_s);
         self.bias_rad_s = zip3(self.bias_rad_s, error, |b, e| {
             clamp(b - step * e, -limit, limit)
@@ -310,7 +336,14 @@ impl AttitudeEstimator {
         );
         self.gravity = gravity;
         let norm = sqrt(dot(gravity, gravity));
-        let turn = turn_weight(config, rate);
+        // On the wheels a spin about "up" tilts nothing and its acceleration at the IMU is in
+        // `own`: only the tilting part of the rate makes the accelerometer less trustworthy.
+        let turning = if motion.on_wheels {
+            cross(rate, up)
+        } else {
+            rate
+        };
+        let turn = turn_weight(config, turning);
         self.track_rest(config, norm, dt_s, turn >= 1.0);
         let weight = self.accel_weight(config, norm) * turn;
         if weight > 0.0 {

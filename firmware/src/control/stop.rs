@@ -23,11 +23,12 @@
 //!    joints start and end at rest) into the kickstand pose ([`StopConfig::kickstand_front`],
 //!    [`StopConfig::kickstand_back`]), as slowly as the deadline allows. The balance law runs
 //!    while the leg pose leaves the wheels on the ground, and stops once the feet carry the robot
-//!    ([`crate::legs::support`]). The front legs end stretched forward on their joint stops, the
-//!    back legs behind and deeper than the wheels, so the robot comes to rest leaning about 12°
-//!    forward on its front feet and wheels. Unpowered, a front leg pushed up by the ground presses
-//!    its hip, knee and ankle further into their stops: the legs are struts, and cutting the
-//!    torque changes nothing.
+//!    ([`crate::legs::support`]). The front legs end stretched forward 2° short of their joint
+//!    stops, the back legs behind and deeper than the wheels, so the robot comes to rest leaning
+//!    about 12° forward on its front feet and wheels. Powered, the servos hold the 2° against the
+//!    load (on the stops themselves, the load pressed a powered joint past its range by up to
+//!    1.8° in the campaign); unpowered, a front leg pushed up by the ground presses its hip, knee
+//!    and ankle into their stops: the legs are struts, and cutting the torque changes little.
 //! 3. **Settle** — the kickstand pose is held for [`StopConfig::settle_ms`].
 //! 4. **Off** — legs disabled, wheel torque 0.
 //!
@@ -110,7 +111,7 @@ pub struct StopConfig {
     /// Damping the wheels hold still with in a stop against an obstacle, N·m per rad/s of
     /// wheel rate (the per-wheel torque limit clamps it).
     pub wheel_hold_nm_per_rad_s: f32,
-    /// Kickstand pose of the front legs.
+    /// Kickstand pose of the front legs (short of the joint stops: see the module docs).
     pub kickstand_front: LegJoints,
     /// Kickstand pose of the back legs.
     pub kickstand_back: LegJoints,
@@ -130,15 +131,15 @@ impl StopConfig {
         wheel_hold_nm_per_rad_s: 10.0,
         kickstand_front: LegJoints {
             hip_abduction_rad: 0.0,
-            hip_pitch_rad: deg_to_rad(50.0),
-            knee_rad: deg_to_rad(15.0),
-            ankle_rad: deg_to_rad(40.0),
+            hip_pitch_rad: deg_to_rad(48.0),
+            knee_rad: deg_to_rad(13.0),
+            ankle_rad: deg_to_rad(38.0),
         },
         kickstand_back: LegJoints {
             hip_abduction_rad: 0.0,
-            hip_pitch_rad: deg_to_rad(-50.0),
-            knee_rad: deg_to_rad(15.0),
-            ankle_rad: deg_to_rad(40.0),
+            hip_pitch_rad: deg_to_rad(-48.0),
+            knee_rad: deg_to_rad(13.0),
+            ankle_rad: deg_to_rad(38.0),
         },
     };
 
