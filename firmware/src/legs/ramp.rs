@@ -59,10 +59,19 @@ impl Ramp {
 
     /// The pose at `now`, and whether the ramp is over.
     pub fn at(&self, now: Tick) -> (Joints<f32>, bool) {
+        self.at_warped(now, 0.0)
+    }
+
+    /// As [`Ramp::at`], with time warped so that the middle of the move goes `1 − slow` times
+    /// as fast as an even pace and its ends `1 + 2 slow` times (`slow` within 0…1; 0: no warp):
+    /// for a move whose middle is where it pushes hardest.
+    pub fn at_warped(&self, now: Tick, slow: f32) -> (Joints<f32>, bool) {
         if now.since(self.start) >= self.ticks {
             return (self.to, true);
         }
-        let s = self.progress(now);
+        let c = crate::math::clamp(slow, 0.0, 1.0);
+        let d = self.progress(now) - 0.5;
+        let s = 0.5 + d * (1.0 - c) + 4.0 * c * d * d * d;
         let blend = s * s * (3.0 - 2.0 * s);
         let mut pose = self.from;
         for (joint, goal) in pose.iter_mut().zip(self.to.iter()) {
