@@ -3,8 +3,11 @@
 //! prints the new ones), and checks the firmware's own `Balance` on the model.
 
 use firmware::config::Config;
-use firmware::wheels::balance::{Balance, BalanceConfig, BalanceGains, BalanceInput, BalanceModel};
-use nalgebra::{Matrix1, Matrix4, Matrix4x1, SMatrix};
+use firmware::wheels::balance::{
+    Balance, BalanceConfig, BalanceGains, BalanceInput, BalanceModel, DESIGN_DELAY_TICKS,
+};
+use nalgebra::{DMatrix, Matrix4, Matrix4x1, SMatrix};
+use std::ops::AddAssign;
 
 const GRAVITY: f64 = 9.81;
 const DT_S: f64 = 0.004;
@@ -46,45 +49,96 @@ fn discrete(a: &Matrix4<f64>, b: &Matrix4x1<f64>, dt: f64) -> (Matrix4<f64>, Mat
     )
 }
 
-/// Discrete LQR by iterating the Riccati equation to convergence.
-fn lqr(a: &Matrix4<f64>, b: &Matrix4x1<f64>, q: &Matrix4<f64>, r: f64) -> [f64; 4] {
-    let mut p = *q;
+/// The discrete model with an input delay of `delay` ticks: state `[x, τ_{k−1}, …, τ_{k−delay}]`,
+/// the torque given now entering the register and the oldest one acting on the pendulum.
+fn delayed(a: &Matrix4<f64>, b: &Matrix4x1<f64>, delay: usize) -> (DMatrix<f64>, DMatrix<f64>) {
+    let n = 4 + delay;
+    let mut ad = DMatrix::zeros(n, n);
+    let mut bd = DMatrix::zeros(n, 1);
+    ad.view_mut((0, 0), (4, 4)).copy_from(a);
+    if delay == 0 {
+        bd.view_mut((0, 0), (4, 1)).copy_from(b);
+    } else {
+        ad.view_mut((0, n - 1), (4, 1)).copy_from(b);
+        bd[(4, 0)] = 1.0;
+        for k in 1..delay {
+            ad[(4 + k, 4 + k - 1)] = 1.0;
+        }
+    }
+    (ad, bd)
+}
+
+/// Discrete LQR by iterating the Riccati equation to convergence: `K` of `u = −K z`.
+fn lqr(a: &DMatrix<f64>, b: &DMatrix<f64>, q: &DMatrix<f64>, r: f64) -> Vec<f64> {
+    let r = DMatrix::from_element(1, 1, r);
+    let gain = |p: &DMatrix<f64>| {
+        (&r + b.transpose() * p * b).try_inverse().expect("R > 0") * b.transpose() * p * a
+    };
+    let mut p = q.clone();
     for _ in 0..200_000 {
-        let gain_denominator = Matrix1::new(r) + b.transpose() * p * b;
-        let k = gain_denominator.try_inverse().expect("R > 0") * b.transpose() * p * a;
-        let next = q + a.transpose() * p * (a - b * k);
-        let change = (next - p).abs().max();
+        let k = gain(&p);
+        let next = q + a.transpose() * &p * (a - b * &k);
+        let change = (&next - &p).abs().max();
         p = next;
         if change < 1e-12 * p.abs().max() {
             break;
         }
     }
-    let k = (Matrix1::new(r) + b.transpose() * p * b)
-        .try_inverse()
-        .expect("R > 0")
-        * b.transpose()
-        * p
-        * a;
-    [k[0], k[1], k[2], k[3]]
+    gain(&p).iter().copied().collect()
 }
 
-/// Bryson's rule: each state and the input weighted by 1 / (its largest acceptable value)².
-fn bryson() -> (Matrix4<f64>, f64) {
+/// Bryson's rule: each state and the input weighted by 1 / (its largest acceptable value)²;
+/// the past torques of the delayed model carry no weight of their own.
+fn bryson(delay: usize) -> (DMatrix<f64>, f64) {
     let weight = |largest: f64| 1.0 / (largest * largest);
-    let q = Matrix4::from_diagonal(&nalgebra::Vector4::new(
-        weight(0.15),
-        weight(0.1),
-        weight(0.3),
-        weight(1.0),
-    ));
+    let mut q = DMatrix::zeros(4 + delay, 4 + delay);
+    for (i, largest) in [0.15, 0.1, 0.3, 1.0].into_iter().enumerate() {
+        q[(i, i)] = weight(largest);
+    }
     (q, weight(30.0))
 }
 
-fn designed_gains() -> [f64; 4] {
+fn discrete_model() -> (Matrix4<f64>, Matrix4x1<f64>) {
     let (a, b) = continuous(&BalanceModel::ROBOT);
-    let (ad, bd) = discrete(&a, &b, DT_S);
-    let (q, r) = bryson();
-    lqr(&ad, &bd, &q, r)
+    discrete(&a, &b, DT_S)
+}
+
+fn designed_gains() -> Vec<f64> {
+    let (ad, bd) = discrete_model();
+    let (a, b) = delayed(&ad, &bd, DESIGN_DELAY_TICKS);
+    let (q, r) = bryson(DESIGN_DELAY_TICKS);
+    lqr(&a, &b, &q, r)
+}
+
+/// The largest pole magnitude of the linear model under the committed gains with `delay`
+/// ticks of loop delay (the law's past torques as it keeps them).
+fn loop_radius(delay: usize) -> f64 {
+    let (ad, bd) = discrete_model();
+    let k = BalanceGains::ROBOT.to_array().map(f64::from);
+    let kept = DESIGN_DELAY_TICKS;
+    let n = 4 + delay.max(kept).max(1);
+    // The register holds the last torques, newest first; the law reads the first `kept`, the
+    // pendulum feels the one `delay` ticks old.
+    let mut law = DMatrix::<f64>::zeros(1, n);
+    for (j, gain) in k.iter().enumerate() {
+        law[(0, j)] = -gain;
+    }
+    let mut a = DMatrix::<f64>::zeros(n, n);
+    a.view_mut((0, 0), (4, 4)).copy_from(&ad);
+    if delay == 0 {
+        a.view_mut((0, 0), (4, n))
+            .add_assign(&(DMatrix::from_column_slice(4, 1, bd.as_slice()) * &law));
+    } else {
+        a.view_mut((0, 4 + delay - 1), (4, 1)).add_assign(&bd);
+    }
+    a.row_mut(4).copy_from(&law);
+    for j in 1..n - 4 {
+        a[(4 + j, 4 + j - 1)] = 1.0;
+    }
+    a.complex_eigenvalues()
+        .iter()
+        .map(|l| l.norm())
+        .fold(0.0, f64::max)
 }
 
 #[test]
@@ -97,28 +151,33 @@ fn committed_gains_match_the_lqr_design() {
         .any(|(d, c)| ((c as f64) - d).abs() > 1e-3 * d.abs().max(1.0));
     assert!(
         !stale,
-        "BalanceGains::ROBOT is stale; the LQR design gives\n    position_nm_per_m: {:.4},\n    pitch_nm_per_rad: {:.4},\n    velocity_nm_per_m_s: {:.4},\n    pitch_rate_nm_per_rad_s: {:.4},",
-        designed[0], designed[1], designed[2], designed[3]
+        "BalanceGains::ROBOT is stale; the LQR design gives\n    position_nm_per_m: {:.4},\n    pitch_nm_per_rad: {:.4},\n    velocity_nm_per_m_s: {:.4},\n    pitch_rate_nm_per_rad_s: {:.4},\n    past_torque_nm_per_nm: [{:.4}, {:.4}],",
+        designed[0], designed[1], designed[2], designed[3], designed[4], designed[5]
     );
 }
 
 #[test]
 fn open_loop_is_unstable_and_closed_loop_is_stable() {
-    let (a, b) = continuous(&BalanceModel::ROBOT);
-    let (ad, bd) = discrete(&a, &b, DT_S);
-    let open = ad.complex_eigenvalues();
+    let (ad, _) = discrete_model();
     assert!(
-        open.iter().any(|l| l.norm() > 1.0),
+        ad.complex_eigenvalues().iter().any(|l| l.norm() > 1.0),
         "the pendulum must fall without control"
     );
-    let k = designed_gains();
-    let k = nalgebra::RowVector4::new(k[0], k[1], k[2], k[3]);
-    let closed = (ad - bd * k).complex_eigenvalues();
-    for l in closed.iter() {
-        assert!(
-            l.norm() < 0.999,
-            "closed-loop pole {l} not inside the unit circle"
-        );
+    let radius = loop_radius(DESIGN_DELAY_TICKS);
+    assert!(
+        radius < 0.999,
+        "closed-loop pole at {radius} with the design delay"
+    );
+}
+
+/// The law is designed for a cycle each way; the campaign draws none to two, and the linear
+/// model keeps a margin beyond: stable from no delay to twice the design's and more.
+#[test]
+fn the_loop_stays_stable_from_no_delay_to_three_times_the_design() {
+    for delay in 0..=3 * DESIGN_DELAY_TICKS {
+        let radius = loop_radius(delay);
+        println!("{delay} ticks of loop delay: largest pole {radius:.4}");
+        assert!(radius < 0.999, "{delay} ticks: pole at {radius}");
     }
 }
 

@@ -55,7 +55,7 @@
 //! `A`). So on the wheels the spin about "up" does not count as turning for `w` (its
 //! accelerations are in `a_own`), and `k_p` grows by [`EstimatorConfig::spin_kp_per_rad`] per
 //! rad/s of spin beyond [`EstimatorConfig::turn_trust_rad_s`] (so that nothing changes while
-//! the robot does not spin): at the on-the-spot turn's 2 rad/s the crossover is 6.5 rad/s,
+//! the robot does not spin): at the on-the-spot turn's 2 rad/s the crossover is 4.6 rad/s,
 //! fast against the turn, so the estimate stays where the accelerometer puts it, error and
 //! all, as the trim expects.
 //!
@@ -78,7 +78,7 @@
 //!
 //! What no estimator removes: the accelerometer's own offset tilts "up" (20 mg, a BMI088's
 //! 1σ, is 1.1°). On the wheels that becomes a static pitch error, which the balance law turns
-//! into a position offset of 5 cm per degree (its pitch gain over its position gain, 2.85 m per
+//! into a position offset of 5 cm per degree (its pitch gain over its position gain, 2.97 m per
 //! radian).
 
 mod config;

@@ -66,7 +66,7 @@
 //! ([`Carrier::Blocked`]) means something stands in front of the wheels: the back legs go
 //! straight to their kickstand pose while the front legs stay folded (swung forward they would
 //! push the robot off the obstacle), and the wheels hold still instead of balancing. Driving at
-//! 0.54 m/s into the 6 cm step, the robot stays within 12 cm of where it met the step
+//! 0.53 m/s into the 6 cm step, the robot stays within 13 cm of where it met the step
 //! (`sim-host/tests/stall.rs`).
 //!
 //! Whatever remains undone [`StopConfig::cut_margin_ms`] and a tick before [`SS1_DEADLINE_MS`]

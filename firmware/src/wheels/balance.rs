@@ -26,6 +26,24 @@
 //! [`BalanceModel::ROBOT`], fails if [`BalanceGains::ROBOT`] is stale and prints the new gains,
 //! and checks the closed loop on the linear model.
 //!
+//! # Loop delay
+//!
+//! The state the law reads crossed the bus from the drives and the IMU, and the torque it
+//! computes crosses it back: on the tested default plant a cycle each way, so a torque acts
+//! [`DESIGN_DELAY_TICKS`] ticks after the state it answers. The LQR is therefore solved for
+//! the model with that input delay, its state augmented with the law's own last torques
+//! (which the law knows): `τ_k = −(K_x x_k + K_u [τ_{k−1}, τ_{k−2}])`. Designed without it, the
+//! law leant on the wheels' own viscous friction, which damps the wheel against the body at
+//! once, as no delayed term can: robots with little of it limit-cycled at two cycles each way
+//! (the model with 0.1 N·m·s/rad instead of 2: 46 N·m rms at 10 Hz, 37 % of the ticks at the
+//! torque limit; with the delay in the design 1.1 N·m). In the campaign's 100 trials, which
+//! draw 0–2 cycles each way, the stop after W went 71 → 94 %; designed for 1, 3, 4 or 6 ticks
+//! instead, the whole campaign measured 1.3, 0.7, 1.8 and 13 points below the design for 2.
+//! In a steady state the past torques equal the present one, so the law's feed-forward is
+//! scaled by `1 + Σ k_u` to give the torque it stands for (unscaled, the robot driven into
+//! the 6 cm step no longer tracked its reference closely enough for the stall detector, and
+//! ran back 0.85 m before the runaway detector stopped it).
+//!
 //! The ground speed comes from the wheels: their joint rate is relative to the body, so the
 //! wheel's rate over ground is the joint rate plus the body's pitch rate, `v = r (ω + θ̇)`.
 
@@ -70,7 +88,10 @@ impl BalanceModel {
     };
 }
 
-/// State-feedback gains, `τ = −(k·x)` in N·m.
+/// The loop delay the gains are designed for, ticks: a cycle each way (see the module docs).
+pub const DESIGN_DELAY_TICKS: usize = 2;
+
+/// State-feedback gains, `τ = −(k·x + k_u·[τ_{k−1}, τ_{k−2}])` in N·m.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BalanceGains {
     /// N·m per m of position error.
@@ -81,24 +102,31 @@ pub struct BalanceGains {
     pub velocity_nm_per_m_s: f32,
     /// N·m per rad/s of pitch rate.
     pub pitch_rate_nm_per_rad_s: f32,
+    /// N·m per N·m of the total torque the law gave one and two ticks ago.
+    pub past_torque_nm_per_nm: [f32; DESIGN_DELAY_TICKS],
 }
 
 impl BalanceGains {
-    /// LQR gains for [`BalanceModel::ROBOT`] at 250 Hz (see the module docs).
+    /// LQR gains for [`BalanceModel::ROBOT`] at 250 Hz with [`DESIGN_DELAY_TICKS`] of loop
+    /// delay (see the module docs).
     pub const ROBOT: Self = Self {
         position_nm_per_m: -176.7789,
-        pitch_nm_per_rad: -504.7005,
-        velocity_nm_per_m_s: -205.0894,
-        pitch_rate_nm_per_rad_s: -102.219,
+        pitch_nm_per_rad: -524.7382,
+        velocity_nm_per_m_s: -206.5036,
+        pitch_rate_nm_per_rad_s: -106.3361,
+        past_torque_nm_per_nm: [0.2277, 0.2369],
     };
 
-    /// As an array `[p, θ, v, θ̇]`.
-    pub const fn to_array(self) -> [f32; 4] {
+    /// As an array `[p, θ, v, θ̇, τ_{k−1}, τ_{k−2}]`.
+    pub const fn to_array(self) -> [f32; 4 + DESIGN_DELAY_TICKS] {
+        let [u1, u2] = self.past_torque_nm_per_nm;
         [
             self.position_nm_per_m,
             self.pitch_nm_per_rad,
             self.velocity_nm_per_m_s,
             self.pitch_rate_nm_per_rad_s,
+            u1,
+            u2,
         ]
     }
 }
@@ -207,6 +235,8 @@ pub struct Balance {
     following: bool,
     /// How long the robot has been at rest, s.
     rest_s: f32,
+    /// The torques the law gave the last ticks, newest first, N·m.
+    past_nm: [f32; DESIGN_DELAY_TICKS],
 }
 
 impl Balance {
@@ -223,6 +253,7 @@ impl Balance {
             learning: false,
             following: false,
             rest_s: 0.0,
+            past_nm: [0.0; DESIGN_DELAY_TICKS],
         }
     }
 
@@ -298,8 +329,9 @@ impl Balance {
         self.position_error_m += taken_rad * k.pitch_nm_per_rad / k.position_nm_per_m;
     }
 
-    /// Forgets the position error (when the wheels take over).
+    /// Forgets the position error and its past torques (when the wheels take over).
     pub fn reset(&mut self) {
+        self.past_nm = [0.0; DESIGN_DELAY_TICKS];
         self.position_error_m = 0.0;
         self.velocity_ref_m_s = 0.0;
         self.last_speed_m_s = 0.0;
@@ -423,11 +455,15 @@ impl Balance {
         self.last_speed_m_s = speed;
         let k = self.config.gains;
         let limit = self.config.torque_limit_nm;
+        let [u1, u2] = self.past_nm;
+        let [k1, k2] = k.past_torque_nm_per_nm;
+        let past = k1 * u1 + k2 * u2;
         let torque_at = |position_error_m: f32| {
             -(k.position_nm_per_m * position_error_m
                 + k.pitch_nm_per_rad * pitch
                 + k.velocity_nm_per_m_s * speed_error
-                + k.pitch_rate_nm_per_rad_s * input.pitch_rate_rad_s)
+                + k.pitch_rate_nm_per_rad_s * input.pitch_rate_rad_s
+                + past)
         };
         let bound = self.config.position_error_limit_m;
         let candidate =
@@ -440,12 +476,17 @@ impl Balance {
         if !(saturated && grows) {
             self.position_error_m = candidate;
         }
+        // In a steady state the past torques equal the present one, so the law gives
+        // `(−K_x x + ff) / (1 + Σ k_u)`: the feed-forward is scaled up by as much.
         let feedforward = 2.0 * self.config.wheel_viscous_nm_per_rad_s * velocity_ref
-            / self.config.wheel_radius_m;
-        crate::math::clamp(
+            / self.config.wheel_radius_m
+            * (1.0 + k1 + k2);
+        let torque = crate::math::clamp(
             torque_at(self.position_error_m) + feedforward,
             -limit,
             limit,
-        )
+        );
+        self.past_nm = [torque, u1];
+        torque
     }
 }

@@ -136,12 +136,18 @@ impl Controller {
 
     /// Whether a fold or a stand-up has the robot on its wheels while its feet carry part of
     /// it: the wheels then hold still (a stool on wheels and feet); the balance law takes over
-    /// once a fold's tuck lifts the feet clear, and a stand-up's legs lift the wheels off. Balancing on wheels and feet, the law read the lean
-    /// the feet gave the torso as a fall and drove the robot off its feet into a runaway.
+    /// once a fold's tuck lifts the feet clear. Balancing on wheels and feet, the law read the
+    /// lean the feet gave the torso as a fall and drove the robot off its feet into a runaway.
+    /// A stand-up holds the wheels from its first tick once the robot is no longer rolling:
+    /// balancing while the legs swing out under it, the law answered the shift of their mass
+    /// with a jolt of the wheels, and the torso pitched 7–9° on the way up (5.96° holding).
     pub(super) fn folding_on_feet(&mut self) -> bool {
         if !matches!(self.state, State::Folding(_) | State::Standing(_)) || !self.wheels_may_drive()
         {
             return false;
+        }
+        if matches!(self.state, State::Standing(_)) && !self.rolling() {
+            return true;
         }
         let support = self.config.support;
         self.stance().height_m >= support.wheel_contact_height_m - support.margin_m

@@ -74,7 +74,7 @@ impl EstimatorConfig {
         bias_limit_rad_s: 0.1,
         max_gap_ms: 100,
         imu_above_axle_m: 0.15,
-        spin_kp_per_rad: 3.0,
+        spin_kp_per_rad: 2.0,
         accel_filter_s: 0.04,
     };
 }
