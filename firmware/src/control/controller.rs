@@ -260,7 +260,7 @@ impl Controller {
             }
             State::Fault if self.stop.is_some() => legs_enabled &= self.run_stop(now),
             State::Hold | State::Fault => {}
-            State::Standing(motion) if self.rolling() => {
+            State::Standing(motion) if self.unsettled() => {
                 // Stop on the wheels first: legs that unfold under a rolling robot lift it off
                 // its wheels with its momentum still in it, and it topples (measured: driving
                 // forward at 0.48 m/s, standing up flipped it over). The goal is set, so the

@@ -28,21 +28,17 @@
 //!
 //! # Loop delay
 //!
-//! The state the law reads crossed the bus from the drives and the IMU, and the torque it
-//! computes crosses it back: on the tested default plant a cycle each way, so a torque acts
-//! [`DESIGN_DELAY_TICKS`] ticks after the state it answers. The LQR is therefore solved for
-//! the model with that input delay, its state augmented with the law's own last torques
-//! (which the law knows): `τ_k = −(K_x x_k + K_u [τ_{k−1}, τ_{k−2}])`. Designed without it, the
-//! law leant on the wheels' own viscous friction, which damps the wheel against the body at
-//! once, as no delayed term can: robots with little of it limit-cycled at two cycles each way
-//! (the model with 0.1 N·m·s/rad instead of 2: 46 N·m rms at 10 Hz, 37 % of the ticks at the
-//! torque limit; with the delay in the design 1.1 N·m). In the campaign's 100 trials, which
-//! draw 0–2 cycles each way, the stop after W went 71 → 94 %; designed for 1, 3, 4 or 6 ticks
-//! instead, the whole campaign measured 1.3, 0.7, 1.8 and 13 points below the design for 2.
-//! In a steady state the past torques equal the present one, so the law's feed-forward is
-//! scaled by `1 + Σ k_u` to give the torque it stands for (unscaled, the robot driven into
-//! the 6 cm step no longer tracked its reference closely enough for the stall detector, and
-//! ran back 0.85 m before the runaway detector stopped it).
+//! The state the law reads crossed the bus, and its torque crosses it back: on the default
+//! plant a cycle each way, so a torque acts [`DESIGN_DELAY_TICKS`] ticks after the state it
+//! answers. The LQR is solved for the model with that input delay, its state augmented with
+//! the law's own last torques: `τ_k = −(K_x x_k + K_u [τ_{k−1}, τ_{k−2}])`. Designed without
+//! it, the law leant on the wheels' viscous friction, which damps the wheel against the body at
+//! once: with 0.1 N·m·s/rad instead of 2 and two cycles each way the robot limit-cycled (46 N·m
+//! rms at 10 Hz, 37 % of the ticks at the limit; designed for the delay 1.1 N·m). The campaign's
+//! stop after W: 71 → 94 % of 100 trials; designs for 1, 3, 4, 6 ticks measured 1.3, 0.7, 1.8,
+//! 13 points below. In a steady state the past torques equal the present one, so the
+//! feed-forward is scaled by `1 + Σ k_u` (unscaled, driven into the 6 cm step the robot
+//! tracked its reference too loosely for the stall detector and ran back 0.85 m).
 //!
 //! The ground speed comes from the wheels: their joint rate is relative to the body, so the
 //! wheel's rate over ground is the joint rate plus the body's pitch rate, `v = r (ω + θ̇)`.
@@ -395,6 +391,33 @@ impl Balance {
         self.config.wheel_radius_m * (input.wheel_rate_rad_s + input.pitch_rate_rad_s)
     }
 
+    /// Takes `velocity_ref` as the reference and re-anchors the position error where a motion
+    /// starts or ends.
+    ///
+    /// A drive starts from where the robot is: a position error still remembered from before
+    /// (a fold's return to its start) would be distance the drive owes. A stop holds the robot
+    /// where it came to rest, not where the speed reference did: the robot lags the reference
+    /// while braking, and rolling back to the reference's stop point would be a second motion
+    /// nobody asked for. So once the reference is at rest and the robot's own speed has come to
+    /// zero (or changed sign), the remembered position error is dropped, once per stop.
+    fn anchor(&mut self, input: &BalanceInput, velocity_ref: f32) {
+        if self.velocity_ref_m_s == 0.0 && velocity_ref != 0.0 {
+            self.position_error_m = 0.0;
+        }
+        self.velocity_ref_m_s = velocity_ref;
+        let speed = self.ground_speed_m_s(input);
+        if input.velocity_ref_m_s == 0.0 && velocity_ref == 0.0 {
+            let stopped = speed * self.last_speed_m_s <= 0.0 || speed.abs() < STOPPED_M_S;
+            if !self.anchored && stopped {
+                self.position_error_m = 0.0;
+                self.anchored = true;
+            }
+        } else {
+            self.anchored = false;
+        }
+        self.last_speed_m_s = speed;
+    }
+
     /// One tick of `dt_s`: the total wheel torque, N·m, within ±`torque_limit_nm`. Any
     /// non-finite input gives zero torque and leaves the state untouched.
     pub fn update(&mut self, input: &BalanceInput, dt_s: f32) -> f32 {
@@ -436,23 +459,7 @@ impl Balance {
         {
             return 0.0;
         }
-        self.velocity_ref_m_s = velocity_ref;
-        // A stop holds the robot where it came to rest, not where the speed reference did:
-        // the robot lags the reference while braking, and rolling back to the reference's stop
-        // point would be a second motion nobody asked for. So once the reference is at rest
-        // and the robot's own speed has come to zero (or changed sign), the remembered
-        // position error is dropped, once per stop.
-        let speed = self.ground_speed_m_s(input);
-        if input.velocity_ref_m_s == 0.0 && velocity_ref == 0.0 {
-            let stopped = speed * self.last_speed_m_s <= 0.0 || speed.abs() < STOPPED_M_S;
-            if !self.anchored && stopped {
-                self.position_error_m = 0.0;
-                self.anchored = true;
-            }
-        } else {
-            self.anchored = false;
-        }
-        self.last_speed_m_s = speed;
+        self.anchor(input, velocity_ref);
         let k = self.config.gains;
         let limit = self.config.torque_limit_nm;
         let [u1, u2] = self.past_nm;

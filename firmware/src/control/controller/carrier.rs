@@ -11,6 +11,12 @@ use crate::control::estimator::Motion;
 use crate::control::fsm::State;
 use crate::legs::support::LegStance;
 
+/// A stand-up waits while the body leans more than this from its balance point, rad.
+const STAND_LEAN_RAD: f32 = 0.08;
+
+/// … or pitches faster than this, rad/s.
+const STAND_STILL_RAD_S: f32 = 0.3;
+
 impl Controller {
     /// What the attitude estimator should know of the torso's own acceleration this tick: on
     /// the wheels while the balance law drives them, the change of the ground speed
@@ -47,6 +53,17 @@ impl Controller {
         let speed_m_s = r * self.sensors.mean_wheel_rate_rad_s();
         let turn_m_s = r * self.sensors.differential_wheel_rate_rad_s();
         self.wheels_may_drive() && (speed_m_s.abs() > 0.05 || turn_m_s.abs() > 0.05)
+    }
+
+    /// Whether a robot on its wheels is not yet settled for a stand-up: it still rolls, or its
+    /// body still leans more than [`STAND_LEAN_RAD`] from its balance point or pitches faster
+    /// than [`STAND_STILL_RAD_S`] (a stop's brake leans it forward by up to 13°; legs unfolded
+    /// under that lean land their front feet first and stand the robot up nose-down).
+    pub(super) fn unsettled(&mut self) -> bool {
+        let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
+        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        let leaning = lean_rad.abs() > STAND_LEAN_RAD || pitch_rate_rad_s.abs() > STAND_STILL_RAD_S;
+        self.rolling() || (self.wheels_may_drive() && leaning)
     }
 
     /// On the wheels the balance law always runs; while folding or standing up only once the

@@ -146,7 +146,7 @@ impl Controller {
         {
             return false;
         }
-        if matches!(self.state, State::Standing(_)) && !self.rolling() {
+        if matches!(self.state, State::Standing(_)) && !self.unsettled() {
             return true;
         }
         let support = self.config.support;
