@@ -261,10 +261,10 @@ impl Controller {
             State::Fault if self.stop.is_some() => legs_enabled &= self.run_stop(now),
             State::Hold | State::Fault => {}
             State::Standing(motion) if self.unsettled() => {
-                // Stop on the wheels first: legs that unfold under a rolling robot lift it off
-                // its wheels with its momentum still in it, and it topples (measured: driving
-                // forward at 0.48 m/s, standing up flipped it over). The goal is set, so the
-                // transition is not taken as done, but the legs wait.
+                // Settle on the wheels first (`unsettled`): legs that unfold under a rolling
+                // robot lift it off its wheels with its momentum in it (driving at 0.48 m/s,
+                // standing up flipped it over). The goal is set, so the transition is not
+                // taken as done, but the legs wait.
                 self.leg_goal(motion, depth_m);
             }
             State::Legs(motion) | State::Standing(motion) => {

@@ -138,9 +138,10 @@ impl Controller {
     /// it: the wheels then hold still (a stool on wheels and feet); the balance law takes over
     /// once a fold's tuck lifts the feet clear. Balancing on wheels and feet, the law read the
     /// lean the feet gave the torso as a fall and drove the robot off its feet into a runaway.
-    /// A stand-up holds the wheels from its first tick once the robot is no longer rolling:
-    /// balancing while the legs swing out under it, the law answered the shift of their mass
-    /// with a jolt of the wheels, and the torso pitched 7–9° on the way up (5.96° holding).
+    /// A stand-up holds the wheels from its first tick once the robot is settled on them
+    /// ([`Controller::unsettled`]): balancing while the legs swing out under it, the law
+    /// answered the shift of their mass with a jolt of the wheels, and the torso pitched 7–9°
+    /// on the way up (4.9° holding).
     pub(super) fn folding_on_feet(&mut self) -> bool {
         if !matches!(self.state, State::Folding(_) | State::Standing(_)) || !self.wheels_may_drive()
         {
