@@ -4,6 +4,7 @@ use crate::control::estimator::EstimatorConfig;
 use crate::control::stop::StopConfig;
 use crate::legs::gait::TrotParams;
 use crate::legs::kinematics::LegGeometry;
+use crate::legs::levelling::LevellingConfig;
 use crate::legs::posture::Posture;
 use crate::legs::smoothing::Smoother;
 use crate::legs::support::SupportGeometry;
@@ -23,8 +24,10 @@ pub struct Config {
     pub geometry: LegGeometry,
     /// Joint ranges.
     pub limits: JointLimits,
-    /// Fold and stance poses.
+    /// Stance poses.
     pub posture: Posture,
+    /// The fold poses, and how the legs level the robot on its wheels.
+    pub levelling: LevellingConfig,
     /// What touches the ground: when the wheels may be driven.
     pub support: SupportGeometry,
     /// Trot.
@@ -93,6 +96,7 @@ impl Config {
         geometry: LegGeometry::ROBOT,
         limits: JointLimits::REPORT,
         posture: Posture::ROBOT,
+        levelling: LevellingConfig::ROBOT,
         support: SupportGeometry::ROBOT,
         trot: TrotParams::DEFAULT,
         leg_rate_per_s: Smoother::LEG_RATE_PER_S,
@@ -108,7 +112,7 @@ impl Config {
             wheel_radius_m: BalanceModel::ROBOT.wheel_radius_m,
             torque_limit_nm: 2.0 * WHEEL_TORQUE_LIMIT_NM,
             position_error_limit_m: 0.3,
-            pitch_trim_rad: crate::math::deg_to_rad(3.2),
+            pitch_trim_rad: crate::math::deg_to_rad(1.4),
             trim_time_constant_s: 2.0,
             trim_range_rad: crate::math::deg_to_rad(15.0),
             trim_follow_time_constant_s: 0.1,

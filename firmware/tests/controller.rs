@@ -87,16 +87,23 @@ fn w_folds_the_legs_through_the_touchdown_pose_then_drives_on_the_wheels() {
             firmware::control::fsm::Direction::Forward
         ))
     );
-    // The fold: front hips at +50°, back hips at −45° (see `Posture::ROBOT`).
-    let front_hip = bench.joints_rad.leg(Leg::Fl)[1];
-    let back_hip = bench.joints_rad.leg(Leg::Bl)[1];
+    // The fold at the levelling's shift (see `legs::levelling`): the bench's torso is level,
+    // so the legs are where a robot that balances upright keeps them, once the smoothing has
+    // followed the last of the levelling.
+    bench.run(250);
+    let levelling = bench.controller.levelling();
+    let fold = levelling.pose(&CONFIG.levelling);
+    for leg in Leg::ALL {
+        for (joint, goal) in bench.joints_rad.leg(leg).iter().zip(fold.leg(leg)) {
+            assert!(
+                (joint - goal).abs() < 0.011,
+                "{leg:?} at {joint}, fold {goal}"
+            );
+        }
+    }
     assert!(
-        (front_hip - 50f32.to_radians()).abs() < 0.011,
-        "front hip {front_hip}"
-    );
-    assert!(
-        (back_hip - (-45f32).to_radians()).abs() < 0.011,
-        "back hip {back_hip}"
+        levelling.shift() > 0.0,
+        "the fold with the back legs under the torso"
     );
 }
 

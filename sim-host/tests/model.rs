@@ -77,13 +77,9 @@ fn dropped_with_legs_extended_it_settles_standing_within_2_s() {
 #[test]
 fn folded_on_free_wheels_it_tips_over() {
     let mut p = physics();
-    let posture = firmware::config::Config::ROBOT.posture;
-    let front = posture.fold_front.to_array();
-    let back = posture.fold_back.to_array();
-    let legs = protocol::Joints::from_leg_fn(|leg| {
-        let pose = if (leg as usize) < 2 { front } else { back };
-        pose.map(f64::from)
-    });
+    let levelling = firmware::config::Config::ROBOT.levelling;
+    let fold = levelling.family.pose(levelling.start_shift);
+    let legs = protocol::Joints::from_leg_fn(|leg| fold.leg(leg).map(f64::from));
     // Wheels (r 0.12 at z −0.15) just on the ground, torso level, wheels unpowered.
     p.place(0.12 + 0.15 + 0.001, &legs);
     let mut max_tilt_deg: f64 = 0.0;

@@ -24,6 +24,8 @@ struct Figures {
     drift_m: f64,
     /// The controller's learned trim at the end, degrees.
     trim_deg: f32,
+    /// The torso's pitch at the end, degrees, positive nose down (as the trim).
+    pitch_deg: f64,
     /// Whether the controller balanced at rest from the settling time on.
     balancing: bool,
 }
@@ -56,27 +58,29 @@ fn rest_on(plant: Plant, offset_m: f64, settle_s: f64) -> Figures {
         let state = rig.records().last().unwrap().state;
         balancing &= state == Some(State::Wheels(WheelMotion::Balance));
     }
-    let node = rig.controller().unwrap().node();
+    let controller = rig.controller().unwrap().node().controller();
     Figures {
         offset_m,
         drift_m: high - low,
-        trim_deg: node.controller().balance().pitch_trim_rad().to_degrees(),
+        trim_deg: controller.balance().pitch_trim_rad().to_degrees(),
+        pitch_deg: rig.sim().physics().torso().rpy_rad()[1].to_degrees(),
         balancing,
     }
 }
 
 #[test]
 fn a_centre_of_mass_off_the_drawing_is_learned_and_the_robot_stays_put() {
-    // Behind the axle up to 2 cm, ahead up to 3 cm: further behind, the robot rolls back off
-    // its wheels while the fold tucks its legs, before it has learned anything (see
-    // docs/firmware.md).
-    for offset_m in [-0.02, -0.01, 0.0, 0.015, 0.03] {
+    // ±3 cm, the acceptance's range.
+    for offset_m in [-0.03, -0.02, -0.01, 0.0, 0.015, 0.03] {
         let f = rest(offset_m, 10.0);
         println!("MEASURED resting with the torso's centre of mass off: {f:?}");
         assert!(f.balancing, "{f:?}");
         assert!(f.drift_m < 0.05, "{f:?}");
-        // The balance point moves against the centre of mass: behind, the body leans forward.
-        let moved_deg = f64::from(f.trim_deg) - 3.2;
+        // The trim is where the robot balances (within the chip's accelerometer offset), and
+        // it moves against the centre of mass: behind, the body leans forward.
+        assert!((f64::from(f.trim_deg) - f.pitch_deg).abs() < 1.5, "{f:?}");
+        let nominal_deg = f64::from(firmware::config::Config::ROBOT.balance.pitch_trim_rad);
+        let moved_deg = f64::from(f.trim_deg) - nominal_deg.to_degrees();
         if f.offset_m != 0.0 {
             assert!(
                 moved_deg * f.offset_m < 0.0 && moved_deg.abs() > 2.0,

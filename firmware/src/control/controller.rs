@@ -15,6 +15,7 @@ mod carrier;
 mod folding;
 mod status;
 mod stopping;
+mod supervise;
 
 use protocol::{AnyMessage, DriveFlags, EStopAction, FaultFlags, Joints, Leg, PerDrive};
 
@@ -28,6 +29,7 @@ use crate::control::stop::Stop;
 use crate::control::teleop::Teleop;
 use crate::legs::gait::Trot;
 use crate::legs::kinematics::LegJoints;
+use crate::legs::levelling::Levelling;
 use crate::legs::smoothing::Smoother;
 use crate::legs::support::LegStance;
 use crate::legs::transfer::Transfer;
@@ -50,8 +52,8 @@ pub struct Controller {
     legs_rad: Joints<f32>,
     /// Goal of the smoothing, rad (kept so a failed IK holds the previous goal).
     goal_rad: Joints<f32>,
-    /// The fold pose of all legs, clamped into the joint ranges once at construction.
-    fold_rad: Joints<f32>,
+    /// Where the folded legs put their mass (see [`crate::legs::levelling`]).
+    levelling: Levelling,
     /// Whether the drives have reported positions so the targets start from them.
     armed: bool,
     /// Latest fault report of each drive.
@@ -90,8 +92,13 @@ pub struct Controller {
     /// carried it, then what it rolled on its held wheels (see
     /// [`Controller::carried_forward_m`]).
     fold_ahead_m: f32,
+    /// How far ahead the fold was when the wheels took it, m: the distance of its return.
+    fold_return_m: f32,
     /// When the running fold's legs were tucked (`None` before, or with no fold).
     fold_done_at: Option<Tick>,
+    /// Whether the robot came to balance in place by a stop from a drive or a turn: it then
+    /// holds its place while its trim settles ([`Balance::set_place_holding`]).
+    stopped_on_wheels: bool,
     /// Ground speed of the wheels last tick, m/s (`None` off the wheels): its change is the
     /// acceleration the attitude estimator takes out of the accelerometer's reading.
     last_ground_m_s: Option<f32>,
@@ -116,7 +123,7 @@ impl Controller {
             turn: SpeedLoop::new(config.turn),
             legs_rad: Joints::splat(0.0),
             goal_rad: Joints::splat(0.0),
-            fold_rad: fold_goal(&config),
+            levelling: Levelling::new(&config.levelling),
             armed: false,
             drive_faults: PerDrive::splat(false),
             tilted: false,
@@ -134,7 +141,9 @@ impl Controller {
             leg_stance: None,
             fold_origin_x_m: None,
             fold_ahead_m: 0.0,
+            fold_return_m: 0.0,
             fold_done_at: None,
+            stopped_on_wheels: false,
             last_ground_m_s: None,
         })
     }
@@ -159,41 +168,14 @@ impl Controller {
         &self.balance
     }
 
+    /// The levelling (the fold's shift).
+    pub fn levelling(&self) -> &Levelling {
+        &self.levelling
+    }
+
     /// The trot generator (its phase).
     pub fn trot(&self) -> &Trot {
         &self.trot
-    }
-
-    /// Whether the link is degraded (as last set by [`Controller::set_link_degraded`]).
-    pub fn link_degraded(&self) -> bool {
-        self.link_degraded
-    }
-
-    /// Tells the controller whether the bus is too lossy to move on (the node's
-    /// [`LinkMonitor`](crate::node::link::LinkMonitor) decides; call before [`Controller::step`]).
-    ///
-    /// When the link becomes degraded the controller stops once, as for a lost operator
-    /// ([`Event::LinkDegraded`]: a trot stands still on four legs, a wheel drive brakes to a
-    /// standstill while balancing), and reports [`FaultFlags::LINK_DEGRADED`](protocol::FaultFlags::LINK_DEGRADED). While it stays
-    /// degraded, operator requests other than Stop are refused — they are still taken as the
-    /// operator's last key, so a teleop that keeps resending its mode neither restarts the
-    /// motion now nor when the link recovers; after recovery the next new key acts.
-    pub fn set_link_degraded(&mut self, degraded: bool) {
-        if degraded && !self.link_degraded {
-            self.apply(Event::LinkDegraded);
-        }
-        self.link_degraded = degraded;
-    }
-
-    /// Tells the controller that this tick did not come after the previous one (`stalled`): in
-    /// lockstep the tick is the simulator's SYNC, and a SYNC whose tick froze or went back would
-    /// freeze every watchdog. The controller faults ([`FaultFlags::SYNC_LOST`](protocol::FaultFlags::SYNC_LOST)) and stays in
-    /// `Fault` until the ticks advance again and the operator sends STOP.
-    pub fn set_clock_stalled(&mut self, stalled: bool) {
-        if stalled && !self.clock_stalled {
-            self.apply(Event::Fault);
-        }
-        self.clock_stalled = stalled;
     }
 
     /// Takes one accepted message received at `now`. Messages the controller does not consume
@@ -264,8 +246,10 @@ impl Controller {
                 // Settle on the wheels first (`unsettled`): legs that unfold under a rolling
                 // robot lift it off its wheels with its momentum in it (driving at 0.48 m/s,
                 // standing up flipped it over). The goal is set, so the transition is not
-                // taken as done, but the legs wait.
+                // taken as done, but the legs wait, or go to the fold a stand-up starts
+                // from (`Levelling::stow`).
                 self.leg_goal(motion, depth_m);
+                self.stow_legs();
             }
             State::Legs(motion) | State::Standing(motion) => {
                 self.leg_goal(motion, depth_m);
@@ -277,7 +261,7 @@ impl Controller {
             }
             State::Folding(_) => self.fold_step(now, depth_m),
             State::Wheels(_) => {
-                self.goal_rad = self.fold_rad;
+                self.goal_rad = self.fold_rad();
                 self.smooth(self.config.fold_rate_per_s);
             }
         }
@@ -286,19 +270,19 @@ impl Controller {
         } else if self.balancing() && self.armed && self.wheels_may_drive() {
             let since = *self.wheels_since.get_or_insert(now);
             if since == now && matches!(self.state, State::Folding(_)) {
-                // The wheels take the robot where the feet carried it: back to where it stood.
-                let carried_m = self.carried_forward_m();
-                self.balance.hold_at(carried_m);
+                self.fold_return_m = self.carried_forward_m();
             }
             wheel_torque_nm = self.wheel_law(now, dt_s);
             if matches!(self.state, State::Folding(_)) {
                 self.ramp_in(&mut wheel_torque_nm, now.since(since));
+                self.fold_ahead_m += self.ground_speed_m_s() * dt_s;
             }
         } else {
             self.wheels_since = None;
             self.balance.reset();
             self.turn.reset();
         }
+        self.level(dt_s);
         if matches!(self.state, State::Legs(LegMotion::Trot(_))) {
             self.trot.advance();
         }
@@ -316,29 +300,6 @@ impl Controller {
             leg_targets_rad,
             wheel_torque_nm,
             status: self.status(now, depth_m),
-        }
-    }
-
-    fn supervise(&mut self, now: Tick) {
-        if !self.armed && self.sensors.drives_ever_reported() && !self.sensors.drives_stale(now) {
-            self.armed = true;
-            self.follow_measured();
-        }
-        let known = self.sensors.attitude_known(now);
-        self.tilted = known && self.sensors.attitude.tilt_rad() > self.config.tilt_limit_rad;
-        if self.teleop.just_lost(now) {
-            self.apply(Event::TeleopLost);
-        }
-        self.fault_on_held_cause();
-        if !self.armed || matches!(self.state, State::EStop | State::Fault) {
-            return;
-        }
-        let moving = !matches!(self.state, State::Hold);
-        if self.sensors.drives_stale(now)
-            || (!known && self.state.balancing() && self.wheels_may_drive())
-            || (self.tilted && moving)
-        {
-            self.apply(Event::Fault);
         }
     }
 
@@ -396,6 +357,11 @@ impl Controller {
             self.fold_ahead_m = 0.0;
             self.fold_done_at = None;
         }
+        let moving_on_wheels = matches!(
+            self.state,
+            State::Wheels(WheelMotion::Drive(_) | WheelMotion::Rotate)
+        );
+        self.stopped_on_wheels = moving_on_wheels && next == State::Wheels(WheelMotion::Balance);
         self.state = next;
     }
 
@@ -453,6 +419,7 @@ impl Controller {
                 (-speed * config.balance.wheel_radius_m, 0.0)
             }
             State::Wheels(WheelMotion::Rotate) => (0.0, speed),
+            State::Folding(_) => (self.fold_return_m_s(now), 0.0),
             _ => (0.0, 0.0),
         };
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
@@ -484,17 +451,4 @@ impl Controller {
         let (left, right) = mix(common, differential, config.wheel_torque_limit_nm);
         [left, right]
     }
-}
-
-/// The fold pose for all four legs, clamped into the joint ranges.
-fn fold_goal(config: &Config) -> Joints<f32> {
-    let front = config.posture.fold_front.to_array();
-    let back = config.posture.fold_back.to_array();
-    let mut goal = Joints::from_leg_fn(|leg| match leg {
-        Leg::Fl | Leg::Fr => front,
-        Leg::Bl | Leg::Br => back,
-    });
-    let fallback = goal;
-    clamp_leg_targets(&config.limits, &mut goal, &fallback);
-    goal
 }

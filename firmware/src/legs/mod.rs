@@ -1,4 +1,5 @@
-//! The legs: [`kinematics`] (IK/FK of one leg), the poses ([`posture`]: stance and fold), the
+//! The legs: [`kinematics`] (IK/FK of one leg), the poses ([`posture`]: the stance; the fold and
+//! its [`levelling`]), the
 //! trot ([`gait`] with its [`phase`] clock, [`foot_trajectory`] and the report's
 //! [`sine_gait`]), [`smoothing`] of targets, joint-space [`ramp`]s, the [`transfer`] from the
 //! legs onto the wheels and [`support`] (which feet carry the robot).
@@ -6,6 +7,7 @@
 pub mod foot_trajectory;
 pub mod gait;
 pub mod kinematics;
+pub mod levelling;
 pub mod phase;
 pub mod posture;
 pub mod ramp;

@@ -1,5 +1,5 @@
-//! The two resting poses of the legs — folded for the wheels, and the stance that carries the
-//! body at a commanded height — and how the foot pitch is chosen for the IK.
+//! The stance that carries the body at a commanded height, and how the foot pitch is chosen
+//! for the IK. (The fold for the wheels is [`crate::legs::levelling`]'s.)
 //!
 //! # Body height
 //!
@@ -29,10 +29,6 @@ use crate::math::deg_to_rad;
 /// Poses and the foot-pitch schedule.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Posture {
-    /// Fold pose of the front legs (for the wheels).
-    pub fold_front: LegJoints,
-    /// Fold pose of the back legs.
-    pub fold_back: LegJoints,
     /// Feet below the hips at zero body-height offset, m.
     pub depth_nominal_m: f32,
     /// Shallowest stance the legs realise, m.
@@ -55,42 +51,8 @@ pub struct Posture {
 }
 
 impl Posture {
-    /// The report's fold pose (0, −1.0, −1.0, 0.3) rad, the same for all four legs. Its hip
-    /// pitch of −1.0 rad lies past the report's own ±50° (0.873 rad) limit; clamped there, it
-    /// folds every foot backward and leaves the centre of mass 1.6 cm behind the axle, so the
-    /// balanced robot leans 7° forward (measured in the simulator). Kept for reference; see
-    /// [`Posture::ROBOT`] for the fold in use.
-    pub const REPORT_FOLD: LegJoints = LegJoints {
-        hip_abduction_rad: 0.0,
-        hip_pitch_rad: -1.0,
-        knee_rad: -1.0,
-        ankle_rad: 0.3,
-    };
-
     /// Defaults for the robot's links and the report's joint ranges.
-    ///
-    /// The fold tucks the front legs under the front of the torso (hip +50°, knee −100°,
-    /// ankle −40°) and the back legs behind (−45°, −50°, −20°), which puts the centre of mass
-    /// 7 mm behind the axle: the balanced robot leans 3.2° forward
-    /// ([`crate::config::Config::ROBOT`]'s pitch trim). With the report's fold the 7° lean at
-    /// rest leaves 3° of the 10° tilt budget for accelerating, and accelerating at `a` needs a
-    /// further lean of about 0.2 rad per m/s² (the wheel torque's reaction tilts the body too),
-    /// which would cap forward acceleration near 0.25 m/s². Chosen by a scan of the joint
-    /// ranges: the least lean with every leg point ≥ 2 cm above flat ground at ±12° pitch (a
-    /// foot that touches down while balancing breaks the pendulum and the balance law).
     pub const ROBOT: Self = Self {
-        fold_front: LegJoints {
-            hip_abduction_rad: 0.0,
-            hip_pitch_rad: deg_to_rad(50.0),
-            knee_rad: deg_to_rad(-100.0),
-            ankle_rad: deg_to_rad(-40.0),
-        },
-        fold_back: LegJoints {
-            hip_abduction_rad: 0.0,
-            hip_pitch_rad: deg_to_rad(-45.0),
-            knee_rad: deg_to_rad(-50.0),
-            ankle_rad: deg_to_rad(-20.0),
-        },
         depth_nominal_m: 0.35,
         depth_min_m: 0.30,
         depth_max_m: 0.37,

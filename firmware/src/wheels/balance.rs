@@ -1,131 +1,13 @@
 //! Balance on two coaxial wheels: the robot with its legs folded is a wheeled inverted
 //! pendulum (as Ascento, Upkie and TITA are), kept upright by full-state feedback.
 //!
-//! # Model and derivation
-//!
-//! Planar, linearised about upright. States `x = [p, θ, v, θ̇]`: position error along the
-//! ground `p` (m, the integral of the speed error), body pitch `θ` (rad, positive = leaning
-//! forward, IMU about +y), ground speed error `v` (m/s) and pitch rate `θ̇` (rad/s). Input `τ`:
-//! the sum of both wheel torques (N·m), which acts on the wheels and reacts on the body. With
-//! body mass `M` at height `l` above the axle, body pitch inertia `I_b` about its centre of
-//! mass, wheel mass `m_w`, wheel inertia `I_w` (both wheels) and radius `r`, Lagrange's
-//! equations linearised at θ = 0 give
-//!
-//! ```text
-//! (M + m_w + I_w/r²) ẍ + M l θ̈        = τ / r
-//!  M l ẍ              + (I_b + M l²) θ̈ − M g l θ = −τ
-//! ```
-//!
-//! The gains `K` of `τ = −K x` solve the discrete LQR problem for this model at the control
-//! rate, with Bryson weights (p 0.15 m, θ 0.1 rad, v 0.3 m/s, θ̇ 1 rad/s, τ 30 N·m). These
-//! leave the delay margin of a real CAN loop: with the stiffer p 0.1 m and v 0.2 m/s the
-//! simulated robot at rest fell into a 15.5 Hz limit cycle at full torque with 12 ms of loop
-//! latency (a mode of the body the pendulum model does not have; `sim-host/tests/latency.rs`);
-//! the softer p 0.2 m and v 0.5 m/s brake too late for the E-stop's 1 s to rest.
-//! The design lives in `firmware/tests/balance_lqr.rs` (host, `nalgebra`): it recomputes `K` from
-//! [`BalanceModel::ROBOT`], fails if [`BalanceGains::ROBOT`] is stale and prints the new gains,
-//! and checks the closed loop on the linear model.
-//!
-//! # Loop delay
-//!
-//! The state the law reads crossed the bus, and its torque crosses it back: on the default
-//! plant a cycle each way, so a torque acts [`DESIGN_DELAY_TICKS`] ticks after the state it
-//! answers. The LQR is solved for the model with that input delay, its state augmented with
-//! the law's own last torques: `τ_k = −(K_x x_k + K_u [τ_{k−1}, τ_{k−2}])`. Designed without
-//! it, the law leant on the wheels' viscous friction, which damps the wheel against the body at
-//! once: with 0.1 N·m·s/rad instead of 2 and two cycles each way the robot limit-cycled (46 N·m
-//! rms at 10 Hz, 37 % of the ticks at the limit; designed for the delay 1.1 N·m). The campaign's
-//! stop after W: 71 → 94 % of 100 trials; designs for 1, 3, 4, 6 ticks measured 1.3, 0.7, 1.8,
-//! 13 points below. In a steady state the past torques equal the present one, so the
-//! feed-forward is scaled by `1 + Σ k_u` (unscaled, driven into the 6 cm step the robot
-//! tracked its reference too loosely for the stall detector and ran back 0.85 m).
+//! The model, its derivation and the gains' design for the loop delay are in
+//! [`crate::wheels::lqr`].
 //!
 //! The ground speed comes from the wheels: their joint rate is relative to the body, so the
 //! wheel's rate over ground is the joint rate plus the body's pitch rate, `v = r (ω + θ̇)`.
 
-/// Physical parameters of the pendulum (SI units).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BalanceModel {
-    /// Everything but the wheels, kg.
-    pub body_mass_kg: f32,
-    /// Centre of mass of the body above the wheel axle, m.
-    pub com_height_m: f32,
-    /// Body pitch inertia about its centre of mass, kg·m².
-    pub body_pitch_inertia_kg_m2: f32,
-    /// Both wheels, kg.
-    pub wheel_mass_kg: f32,
-    /// Both wheels about the axle, kg·m².
-    pub wheel_inertia_kg_m2: f32,
-    /// Wheel radius, m.
-    pub wheel_radius_m: f32,
-}
-
-impl BalanceModel {
-    /// How much more the body leans than its balance point while the axle accelerates
-    /// steadily, rad per m/s²: the body's moment balance about the axle with the wheels'
-    /// ground force and inertia, `(1 + ((m + m_w) r + I_w / r) / (m l)) / g`.
-    pub const fn lean_rad_per_m_s2(&self) -> f32 {
-        let m = self.body_mass_kg;
-        let pushed = (m + self.wheel_mass_kg) * self.wheel_radius_m
-            + self.wheel_inertia_kg_m2 / self.wheel_radius_m;
-        (1.0 + pushed / (m * self.com_height_m)) / crate::control::estimator::GRAVITY_M_S2
-    }
-
-    /// The robot at the report's density 600 kg/m³, legs folded: torso box 0.6 × 0.5 × 0.18 m
-    /// (32.4 kg, centre 0.15 m above the axle) plus four legs of capsules and a sphere foot
-    /// (≈ 0.85 kg each, near the hips); wheels r = 0.12 m, width 0.09 m (2.44 kg each).
-    pub const ROBOT: Self = Self {
-        body_mass_kg: 35.8,
-        com_height_m: 0.147,
-        body_pitch_inertia_kg_m2: 1.5,
-        wheel_mass_kg: 4.886,
-        wheel_inertia_kg_m2: 0.0352,
-        wheel_radius_m: 0.12,
-    };
-}
-
-/// The loop delay the gains are designed for, ticks: a cycle each way (see the module docs).
-pub const DESIGN_DELAY_TICKS: usize = 2;
-
-/// State-feedback gains, `τ = −(k·x + k_u·[τ_{k−1}, τ_{k−2}])` in N·m.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct BalanceGains {
-    /// N·m per m of position error.
-    pub position_nm_per_m: f32,
-    /// N·m per rad of pitch.
-    pub pitch_nm_per_rad: f32,
-    /// N·m per m/s of speed error.
-    pub velocity_nm_per_m_s: f32,
-    /// N·m per rad/s of pitch rate.
-    pub pitch_rate_nm_per_rad_s: f32,
-    /// N·m per N·m of the total torque the law gave one and two ticks ago.
-    pub past_torque_nm_per_nm: [f32; DESIGN_DELAY_TICKS],
-}
-
-impl BalanceGains {
-    /// LQR gains for [`BalanceModel::ROBOT`] at 250 Hz with [`DESIGN_DELAY_TICKS`] of loop
-    /// delay (see the module docs).
-    pub const ROBOT: Self = Self {
-        position_nm_per_m: -176.7789,
-        pitch_nm_per_rad: -524.7382,
-        velocity_nm_per_m_s: -206.5036,
-        pitch_rate_nm_per_rad_s: -106.3361,
-        past_torque_nm_per_nm: [0.2277, 0.2369],
-    };
-
-    /// As an array `[p, θ, v, θ̇, τ_{k−1}, τ_{k−2}]`.
-    pub const fn to_array(self) -> [f32; 4 + DESIGN_DELAY_TICKS] {
-        let [u1, u2] = self.past_torque_nm_per_nm;
-        [
-            self.position_nm_per_m,
-            self.pitch_nm_per_rad,
-            self.velocity_nm_per_m_s,
-            self.pitch_rate_nm_per_rad_s,
-            u1,
-            u2,
-        ]
-    }
-}
+pub use crate::wheels::lqr::{BalanceGains, BalanceModel, DESIGN_DELAY_TICKS};
 
 /// Limits and trims of the balance law.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -183,8 +65,8 @@ const TRIM_STILL_M_S2: f32 = 0.05;
 const TRIM_REST_M_S: f32 = 0.05;
 
 /// How long a robot must have been at rest before its position error counts as a trim error,
-/// s: right after a stop, or after a fold hands it to the wheels with a deliberate position
-/// error ([`Balance::hold_at`]), it is still on its way back.
+/// s: right after a stop, or while a fold drives it back to where it stood, it is still on its
+/// way back.
 const TRIM_REST_S: f32 = 1.0;
 
 /// Fraction of the position-error bound past which the law has run out of position authority
@@ -229,6 +111,11 @@ pub struct Balance {
     /// Whether the trim may follow the balance point now (see
     /// [`Balance::set_trim_following`]).
     following: bool,
+    /// Whether the trim followed the balance point on the last update.
+    followed: bool,
+    /// Whether a robot at rest holds its place while the trim changes (see
+    /// [`Balance::set_place_holding`]).
+    holding_place: bool,
     /// How long the robot has been at rest, s.
     rest_s: f32,
     /// The torques the law gave the last ticks, newest first, N·m.
@@ -248,16 +135,27 @@ impl Balance {
             accel_m_s2: 0.0,
             learning: false,
             following: false,
+            followed: false,
+            holding_place: false,
             rest_s: 0.0,
             past_nm: [0.0; DESIGN_DELAY_TICKS],
         }
     }
 
     /// Lets the trim be learned, or not: only while the robot balances with its legs folded
-    /// (the pose the trim belongs to), not while a fold hands it to the wheels with a
-    /// deliberate position error ([`Balance::hold_at`]) or it stands up.
+    /// (the pose the trim belongs to), not while a fold drives it back to where it stood or it
+    /// stands up.
     pub fn set_trim_learning(&mut self, learning: bool) {
         self.learning = learning;
+    }
+
+    /// Whether a robot asked to stay where it is holds its place while the trim changes: once
+    /// it has come to rest after a stop, what the trim takes no longer moves the place the law
+    /// holds. A stop's brake leaves the trim off the balance point at rest (it followed the
+    /// lean while driving, which the drive's torque shares), and as the trim found it the
+    /// robot crept 5 cm after it had stopped.
+    pub fn set_place_holding(&mut self, holding: bool) {
+        self.holding_place = holding;
     }
 
     /// Lets the trim follow the balance point the lean shows, or not: while the legs are
@@ -285,7 +183,7 @@ impl Balance {
         }
         // A drift is corrected four times faster: the robot is rolling away meanwhile.
         let tau_s = if drifting { 0.25 * tau_s } else { tau_s };
-        self.take_trim(error_rad, dt_s / tau_s);
+        self.take_trim(error_rad, dt_s / tau_s, !drifting);
     }
 
     /// One step of the trim following the balance point: whenever the body's lean is steady
@@ -303,8 +201,9 @@ impl Balance {
         let balance_point_rad = input.pitch_rad - self.config.lean_rad_per_m_s2 * self.accel_m_s2;
         let error_rad = balance_point_rad - self.trim_rad;
         let tau_s = self.config.trim_follow_time_constant_s;
-        if self.following && steady && error_rad.is_finite() && tau_s > 0.0 {
-            self.take_trim(error_rad, dt_s / tau_s);
+        self.followed = self.following && steady && error_rad.is_finite() && tau_s > 0.0;
+        if self.followed {
+            self.take_trim(error_rad, dt_s / tau_s, false);
         }
     }
 
@@ -313,7 +212,7 @@ impl Balance {
     /// of rolling back to where its position error was counted from. (Letting the robot roll
     /// back instead, as a trim that corrects its own error would, measured worse in every
     /// wheeled scenario of the campaign.)
-    fn take_trim(&mut self, error_rad: f32, gain: f32) {
+    fn take_trim(&mut self, error_rad: f32, gain: f32, hold_place: bool) {
         let k = self.config.gains;
         let gain = crate::math::clamp(gain, 0.0, 1.0);
         let nominal = self.config.pitch_trim_rad;
@@ -322,7 +221,10 @@ impl Balance {
         let learned = crate::math::clamp(learned, nominal - range, nominal + range);
         let taken_rad = learned - self.trim_rad;
         self.trim_rad = learned;
-        self.position_error_m += taken_rad * k.pitch_nm_per_rad / k.position_nm_per_m;
+        let resting = self.holding_place && self.anchored && self.velocity_ref_m_s == 0.0;
+        if !(hold_place || resting) {
+            self.position_error_m += taken_rad * k.pitch_nm_per_rad / k.position_nm_per_m;
+        }
     }
 
     /// Forgets the position error and its past torques (when the wheels take over).
@@ -332,16 +234,7 @@ impl Balance {
         self.velocity_ref_m_s = 0.0;
         self.last_speed_m_s = 0.0;
         self.anchored = true;
-    }
-
-    /// Counts the robot as `ahead_m` ahead of where it should be (bounded as any position
-    /// error): the law rolls it back, and holds it there.
-    pub fn hold_at(&mut self, ahead_m: f32) {
-        if ahead_m.is_finite() {
-            let bound = self.config.position_error_limit_m;
-            self.position_error_m = crate::math::clamp(ahead_m, -bound, bound);
-            self.anchored = true;
-        }
+        self.followed = false;
     }
 
     /// Takes the robot's present ground speed as the speed reference and forgets the position
@@ -374,6 +267,11 @@ impl Balance {
     /// [`Balance::reset`] keeps what was learned.
     pub fn pitch_trim_rad(&self) -> f32 {
         self.trim_rad
+    }
+
+    /// Whether the trim followed the balance point on the last update: it is then fresh.
+    pub fn trim_followed(&self) -> bool {
+        self.followed
     }
 
     /// The speed reference after the acceleration limit, m/s.
@@ -448,6 +346,7 @@ impl Balance {
         };
         let rested = self.rest_s >= TRIM_REST_S;
         self.learn_trim(input, at_rest && rested, at_rest && out_of_authority, dt_s);
+        self.followed = false;
         if input.velocity_ref_m_s == velocity_ref {
             self.follow_balance_point(input, dt_s);
         }

@@ -1,7 +1,9 @@
-//! The wheels: [`balance`] (the LQR that keeps the folded robot upright on its wheels) and
+//! The wheels: [`balance`] (the LQR that keeps the folded robot upright on its wheels, designed
+//! in [`lqr`]) and
 //! [`wheel`] (the turn loop and the mixing into two wheel torques), and [`runaway`] (which
 //! stops the robot when the wheels cannot do what the balance law asks).
 
 pub mod balance;
+pub mod lqr;
 pub mod runaway;
 pub mod wheel;

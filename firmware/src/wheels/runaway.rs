@@ -61,6 +61,10 @@ impl RunawayConfig {
     };
 }
 
+/// Backward speed, m/s, below which a robot blocked against a forward reference counts as
+/// standing still (and the other way round).
+const STALL_STILL_M_S: f32 = 0.02;
+
 /// What the detector reads each tick the balance law runs.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunawayInput {
@@ -77,12 +81,13 @@ pub struct RunawayInput {
 impl RunawayInput {
     /// The fault a trip with this input reports: [`FaultFlags::WHEEL_STALL`] when the robot
     /// is slower than the reference in the reference's direction (something blocks it),
-    /// [`FaultFlags::RUNAWAY`] when it is faster, goes the other way, or moves when asked to
-    /// stay.
+    /// [`FaultFlags::RUNAWAY`] when it is faster, goes the other way (by more than
+    /// [`STALL_STILL_M_S`]: a blocked robot's measured speed is zero give or take the gyro's bias
+    /// in the pitch rate the ground speed adds), or moves when asked to stay.
     fn cause(&self) -> FaultFlags {
         let wanted = self.velocity_ref_m_s;
         let blocked = wanted != 0.0 && self.ground_speed_m_s * wanted.signum() < wanted.abs();
-        let forward_or_still = self.ground_speed_m_s * wanted.signum() >= 0.0;
+        let forward_or_still = self.ground_speed_m_s * wanted.signum() > -STALL_STILL_M_S;
         if blocked && forward_or_still {
             FaultFlags::WHEEL_STALL
         } else {

@@ -5,8 +5,8 @@
 use firmware::control::controller::Output;
 use firmware::Config;
 use protocol::{
-    Acceleration, Angle, AngularRate, AnyMessage, Imu, JointVelocity, Joints, Leg, LegFeedback,
-    Torque, WheelFeedback, WheelVelocity,
+    Acceleration, Angle, AngularRate, AnyMessage, Imu, JointVelocity, Joints, LegFeedback, Torque,
+    WheelFeedback, WheelVelocity,
 };
 
 /// What the plant reports.
@@ -60,11 +60,8 @@ impl Plant {
                 .map_or([0.0; 4], |joints| joints.to_array());
             self.joints_rad = Joints::from_leg_fn(|_| stance);
         } else if mode % 4 == 3 {
-            let (front, back) = (config.posture.fold_front, config.posture.fold_back);
-            self.joints_rad = Joints::from_leg_fn(|leg| match leg {
-                Leg::Fl | Leg::Fr => front.to_array(),
-                Leg::Bl | Leg::Br => back.to_array(),
-            });
+            let levelling = &config.levelling;
+            self.joints_rad = levelling.family.pose(levelling.start_shift);
         }
         self.wheel_rad_s = f32::from(wheel as i8) * 0.05;
         self.pitch_rad = f32::from(pitch as i8) * 0.5_f32.to_radians();

@@ -63,7 +63,8 @@ impl Controller {
         let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
         let leaning = lean_rad.abs() > STAND_LEAN_RAD || pitch_rate_rad_s.abs() > STAND_STILL_RAD_S;
-        self.rolling() || (self.wheels_may_drive() && leaning)
+        let stowing = !self.levelling.stowed();
+        self.rolling() || (self.wheels_may_drive() && (leaning || stowing))
     }
 
     /// On the wheels the balance law always runs; while folding or standing up only once the
@@ -77,7 +78,7 @@ impl Controller {
 
     /// [`Controller::wheels_may_drive`] as far as this tick has found: off the wheels, false
     /// until the legs' stance has been computed.
-    fn wheels_carry(&self) -> bool {
+    pub(super) fn wheels_carry(&self) -> bool {
         matches!(self.state, State::Wheels(_))
             || self
                 .leg_stance

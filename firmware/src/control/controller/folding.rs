@@ -4,7 +4,9 @@
 use protocol::Joints;
 
 use super::Controller;
-use crate::control::fsm::State;
+use crate::control::fsm::{State, WheelMotion};
+use crate::control::safety::clamp_leg_targets;
+use crate::legs::smoothing::Smoother;
 use crate::legs::transfer::Transfer;
 use crate::time::Tick;
 
@@ -12,7 +14,7 @@ use crate::time::Tick;
 /// a fold, ms: a full torque on the first tick of contact jolts it.
 const WHEEL_RAMP_IN_MS: u32 = 300;
 
-/// A fold is back in place when the balance law's position error is below this, m, …
+/// A fold is back in place when the robot is this close to where it stood, m, …
 const FOLD_RETURNED_M: f32 = 0.03;
 
 /// … and the robot rolls slower than this, m/s, …
@@ -21,11 +23,15 @@ const FOLD_REST_M_S: f32 = 0.05;
 /// … or at the latest this long after the legs are tucked, ms.
 const FOLD_SETTLE_MS: u32 = 1_500;
 
+/// How long a fold's return to where it stood takes, ms (see
+/// [`Controller::fold_return_m_s`]).
+const FOLD_RETURN_MS: u32 = 1_000;
+
 impl Controller {
     /// This tick of the fold: started on the first tick of the transition from where the legs
     /// are, through the stance at `depth_m`.
     pub(super) fn fold_step(&mut self, now: Tick, depth_m: f32) {
-        self.goal_rad = self.fold_rad;
+        self.goal_rad = self.fold_rad();
         let mut transfer = match self.transfer {
             Some(running) => running,
             None => {
@@ -43,7 +49,7 @@ impl Controller {
                     }
                     Err(_) => self.legs_rad,
                 };
-                let (from, goal) = (self.legs_rad, self.fold_rad);
+                let (from, goal) = (self.legs_rad, self.fold_rad());
                 Transfer::new(
                     config.transfer,
                     config.rate,
@@ -69,10 +75,15 @@ impl Controller {
                 self.fold_ahead_m = ahead_m;
             }
         }
-        self.legs_rad = pose;
         self.transfer = Some(transfer);
         if done && self.fold_done_at.is_none() {
             self.fold_done_at = Some(now);
+        }
+        if self.fold_done_at.is_some() {
+            // Tucked: the legs follow the levelling from here.
+            self.smooth(self.config.fold_rate_per_s);
+        } else {
+            self.legs_rad = pose;
         }
         self.transfer_done = done && self.back_in_place(now);
     }
@@ -85,7 +96,7 @@ impl Controller {
             return false;
         };
         let speed_m_s = self.ground_speed_m_s();
-        let returned = self.balance.position_error_m().abs() < FOLD_RETURNED_M;
+        let returned = self.carried_forward_m().abs() < FOLD_RETURNED_M;
         let timed_out = now.since(done_at) >= self.config.rate.ticks_from_ms(FOLD_SETTLE_MS);
         (returned && speed_m_s.abs() < FOLD_REST_M_S) || timed_out
     }
@@ -93,13 +104,33 @@ impl Controller {
     /// How far the fold has put the robot ahead of where it stood, m: over the carry, the mean
     /// over the legs of how far each planted foot went back relative to its hip (the wheels
     /// were in the air, so the balance law's own odometry did not see it); after it, what the
-    /// robot rolled on its held wheels while the feet left the ground.
+    /// robot rolled on its held wheels while the feet left the ground, and then balancing.
     pub(super) fn carried_forward_m(&self) -> f32 {
         if self.fold_origin_x_m.is_some() && self.fold_ahead_m.is_finite() {
             self.fold_ahead_m
         } else {
             0.0
         }
+    }
+
+    /// The speed reference that takes a fold back to where it stood, m/s: a half-sine of
+    /// speed over [`FOLD_RETURN_MS`] whose distance is what the carry put the robot ahead when
+    /// the wheels took it; the balance law's position error tracks it. Handed to the law as a
+    /// position error at once instead, its own position loop (about 0.85 /s) took over 2 s to
+    /// bring back the 0.1–0.2 m, and the fold ended by its time-out 7–9 cm from where it began;
+    /// a speed fed back from the remaining distance overshot by what the law lagged.
+    #[inline(never)] // As `level`.
+    pub(super) fn fold_return_m_s(&self, now: Tick) -> f32 {
+        let Some(since) = self.wheels_since else {
+            return 0.0;
+        };
+        let period_s = FOLD_RETURN_MS as f32 * 1e-3;
+        let t_s = now.since(since) as f32 * self.config.rate.period_s();
+        if t_s >= period_s || !self.fold_return_m.is_finite() {
+            return 0.0;
+        }
+        let omega = core::f32::consts::PI / period_s;
+        -self.fold_return_m * 0.5 * omega * crate::math::sin_cos(omega * t_s).0
     }
 
     /// Which of the balance law's trim rules may learn now: from the position error only on
@@ -109,6 +140,9 @@ impl Controller {
         let tucked = matches!(self.state, State::Folding(_)) && self.fold_done_at.is_some();
         self.balance.set_trim_learning(wheels);
         self.balance.set_trim_following(wheels || tucked);
+        let in_place = matches!(self.state, State::Wheels(WheelMotion::Balance));
+        self.balance
+            .set_place_holding(in_place && self.stopped_on_wheels);
     }
 
     /// The wheel torques that hold the wheels still (damped), in a controlled stop or while
@@ -167,5 +201,60 @@ impl Controller {
             _ => false,
         };
         arrived && self.armed
+    }
+
+    /// A stand-up on the wheels not yet stowed: the legs follow the fold toward shift 0
+    /// ([`crate::legs::levelling::Levelling::stow`]).
+    #[inline(never)] // As `level`.
+    pub(super) fn stow_legs(&mut self) {
+        if self.wheels_carry() && !self.levelling.stowed() {
+            let smoother = Smoother::new(self.config.fold_rate_per_s, self.config.rate);
+            let fold_rad = self.fold_rad();
+            for (target, fold) in self.legs_rad.iter_mut().zip(&fold_rad) {
+                *target = smoother.step(*target, *fold);
+            }
+        }
+    }
+
+    /// The fold a controlled stop on the wheels brakes in: the family's pose at shift 0, the
+    /// back legs behind the hips, from where the kickstand swings them straight back and down.
+    /// From a levelled fold the back feet, under the torso, passed deeper than the wheels on
+    /// the way and lifted the robot.
+    #[inline(never)] // As `level`.
+    pub(super) fn stop_fold_rad(&self) -> Joints<f32> {
+        let mut goal = self.config.levelling.family.pose(0.0);
+        let fallback = goal;
+        clamp_leg_targets(&self.config.limits, &mut goal, &fallback);
+        goal
+    }
+
+    /// One tick of the levelling ([`crate::legs::levelling`]): balancing in place and at rest
+    /// with the legs folded (a fold's tuck done included), the shift follows the balance point
+    /// while the trim is fresh; the fold pose follows the shift. Not while driving, turning or
+    /// stopping: the legs' mass moving under a moving robot shifted where it stopped (an X
+    /// after W rolled on past its 5 cm, an E-stop was not at rest within 1 s).
+    #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
+    pub(super) fn level(&mut self, dt_s: f32) {
+        let in_place = matches!(self.state, State::Folding(_)) && self.fold_done_at.is_some();
+        let fresh = self.wheels_since.is_some() && self.balance.trim_followed();
+        let config = &self.config.levelling;
+        if matches!(self.state, State::Standing(_)) {
+            self.levelling.stow(config, dt_s);
+        } else if in_place && fresh {
+            let balance_point_rad = self.balance.pitch_trim_rad();
+            self.levelling.update(config, balance_point_rad, dt_s);
+        } else {
+            self.levelling.unstow(config, dt_s);
+        }
+    }
+
+    /// The fold pose of all legs where the levelling has them, clamped into the joint ranges
+    /// (computed, not kept: the MCU's stack is measured to the byte).
+    #[inline(never)] // As `level`.
+    pub(super) fn fold_rad(&self) -> Joints<f32> {
+        let mut goal = self.levelling.pose(&self.config.levelling);
+        let fallback = goal;
+        clamp_leg_targets(&self.config.limits, &mut goal, &fallback);
+        goal
     }
 }

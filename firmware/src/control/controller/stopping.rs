@@ -30,10 +30,22 @@ impl Controller {
         } else {
             Carrier::Legs
         };
-        let (config, rate) = (self.config.stop, self.config.rate);
-        let stop = Stop::new(config, rate, now, self.legs_rad, self.fold_rad, carrier);
-        self.stop = Some(stop);
+        self.start_stop(now, carrier);
         self.apply(Event::EStopLatch);
+    }
+
+    /// Starts the controlled stop at `now` for what carries the robot.
+    fn start_stop(&mut self, now: Tick, carrier: Carrier) {
+        let (config, rate) = (self.config.stop, self.config.rate);
+        let fold_rad = self.stop_fold_rad();
+        self.stop = Some(Stop::new(
+            config,
+            rate,
+            now,
+            self.legs_rad,
+            fold_rad,
+            carrier,
+        ));
     }
 
     /// An authentic release (the node has checked its token): `Hold` — or `Fault` while a drive
@@ -85,14 +97,12 @@ impl Controller {
         }
         self.wheel_fault = cause;
         self.balance.rebase(ground_speed_m_s);
-        let (config, rate) = (self.config.stop, self.config.rate);
         let carrier = if cause == FaultFlags::WHEEL_STALL {
             Carrier::Blocked
         } else {
             Carrier::Wheels
         };
-        let stop = Stop::new(config, rate, now, self.legs_rad, self.fold_rad, carrier);
-        self.stop = Some(stop);
+        self.start_stop(now, carrier);
     }
 
     /// This tick of the controlled stop (torque-free if none runs).
