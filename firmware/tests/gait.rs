@@ -2,6 +2,7 @@
 //! time reversal, the Cartesian foot path on the ground line, and IK solutions over the whole
 //! body-height band.
 
+use firmware::attitude::Attitude;
 use firmware::config::Config;
 use firmware::control::fsm::Direction;
 use firmware::legs::gait::{Generator, Trot, TrotParams};
@@ -20,6 +21,7 @@ fn targets(trot: &Trot, direction: Direction, depth_m: f32) -> [LegJoints; 4] {
         direction,
         depth_m,
         1.0,
+        &Attitude::default(),
         &CONFIG.geometry,
         &CONFIG.limits,
         &CONFIG.posture,
@@ -177,13 +179,23 @@ fn every_gait_pose_solves_across_the_body_height_band_and_speed_scales() {
             .stance(&CONFIG.geometry, &CONFIG.limits, depth)
             .unwrap_or_else(|e| panic!("stance at {depth} m: {e:?}"));
         let depth = posture.trot_depth_for(offset);
-        for scale in [0.0, 0.5, 1.0] {
+        // Level, and rolled past the body levelling's limit either way (every stance line at
+        // its deepest or shallowest).
+        let rolls = [0.0, 1.0, -1.0].map(|roll_rad| Attitude {
+            pitch_rad: 0.0,
+            roll_rad,
+        });
+        for (scale, attitude) in [0.0, 0.5, 1.0]
+            .into_iter()
+            .flat_map(|scale| rolls.map(|attitude| (scale, attitude)))
+        {
             let mut trot = Trot::new(TrotParams::DEFAULT, TickRate::SIM_250_HZ).unwrap();
             for tick in 0..250 {
                 for (leg, result) in Leg::ALL.iter().zip(trot.targets(
                     Direction::Forward,
                     depth,
                     scale,
+                    &attitude,
                     &CONFIG.geometry,
                     &CONFIG.limits,
                     &posture,

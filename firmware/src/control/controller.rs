@@ -379,6 +379,7 @@ impl Controller {
                 direction,
                 config.posture.trot_depth_for(self.teleop.body_height_m),
                 self.teleop.speed_scale,
+                &self.sensors.attitude,
                 &config.geometry,
                 &config.limits,
                 &config.posture,
