@@ -130,6 +130,30 @@ fn trot_from_the_wheels_stands_up_first() {
     assert!(a.iter().zip(b).any(|(x, y)| (x - y).abs() > 0.02));
 }
 
+/// A stand-up from the wheels first brings the legs to the fold it starts from, balancing; a
+/// fold asked for meanwhile starts on the wheels, where it has nothing to return: the speed
+/// reference stays at zero (an earlier fold's return must not drive the robot again).
+#[test]
+fn a_fold_during_a_stand_up_on_the_wheels_does_not_drive() {
+    let mut bench = Bench::ready();
+    bench.send(command(TeleopMode::Fold));
+    bench.run(1_000);
+    assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+    bench.send(command(TeleopMode::Stand));
+    bench.run(25);
+    assert!(matches!(bench.state(), State::Standing(_)));
+    bench.send(command(TeleopMode::Fold));
+    for tick in 0..500 {
+        bench.tick();
+        let reference_m_s = bench.controller.balance().velocity_ref_m_s();
+        assert!(
+            reference_m_s.abs() < 1e-6,
+            "tick {tick}: {reference_m_s} m/s"
+        );
+    }
+    assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+}
+
 #[test]
 fn silent_feedback_safe_stops_within_fifty_milliseconds() {
     let mut bench = Bench::ready();

@@ -89,11 +89,12 @@ pub struct Controller {
     /// (`None` otherwise).
     fold_origin_x_m: Option<f32>,
     /// How far ahead of where it stood the fold has put the robot, m: what the planted feet
-    /// carried it, then what it rolled on its held wheels (see
+    /// carried it, what it rolled on its held wheels, then balancing (see
     /// [`Controller::carried_forward_m`]).
     fold_ahead_m: f32,
-    /// How far ahead the fold was when the wheels took it, m: the distance of its return.
-    fold_return_m: f32,
+    /// When the wheels took the running fold and how far ahead it was then, m: its return
+    /// (`None` before, or with no fold).
+    fold_return: Option<(Tick, f32)>,
     /// When the running fold's legs were tucked (`None` before, or with no fold).
     fold_done_at: Option<Tick>,
     /// Whether the robot came to balance in place by a stop from a drive or a turn: it then
@@ -141,7 +142,7 @@ impl Controller {
             leg_stance: None,
             fold_origin_x_m: None,
             fold_ahead_m: 0.0,
-            fold_return_m: 0.0,
+            fold_return: None,
             fold_done_at: None,
             stopped_on_wheels: false,
             last_ground_m_s: None,
@@ -232,7 +233,6 @@ impl Controller {
         let dt_s = self.config.rate.period_s();
         let depth_m = self.config.posture.depth_for(self.teleop.body_height_m);
         let previous = self.legs_rad;
-        let mut wheel_torque_nm = [0.0; 2];
         let mut legs_enabled = self.armed;
         let state = self.state;
         match state {
@@ -265,23 +265,7 @@ impl Controller {
                 self.smooth(self.config.fold_rate_per_s);
             }
         }
-        if self.stop.is_some_and(|stop| stop.holds_wheels()) || self.folding_on_feet() {
-            wheel_torque_nm = self.hold_wheels(dt_s);
-        } else if self.balancing() && self.armed && self.wheels_may_drive() {
-            let since = *self.wheels_since.get_or_insert(now);
-            if since == now && matches!(self.state, State::Folding(_)) {
-                self.fold_return_m = self.carried_forward_m();
-            }
-            wheel_torque_nm = self.wheel_law(now, dt_s);
-            if matches!(self.state, State::Folding(_)) {
-                self.ramp_in(&mut wheel_torque_nm, now.since(since));
-                self.fold_ahead_m += self.ground_speed_m_s() * dt_s;
-            }
-        } else {
-            self.wheels_since = None;
-            self.balance.reset();
-            self.turn.reset();
-        }
+        let mut wheel_torque_nm = self.wheel_torques(now, dt_s);
         self.level(dt_s);
         if matches!(self.state, State::Legs(LegMotion::Trot(_))) {
             self.trot.advance();
@@ -301,6 +285,32 @@ impl Controller {
             wheel_torque_nm,
             status: self.status(now, depth_m),
         }
+    }
+
+    /// This tick's wheel torques: held still (a stop against an obstacle, or wheels and feet
+    /// both down in a fold or stand-up), the balance law's where the wheels carry the robot, or
+    /// none.
+    fn wheel_torques(&mut self, now: Tick, dt_s: f32) -> [f32; 2] {
+        if self.stop.is_some_and(|stop| stop.holds_wheels()) || self.folding_on_feet() {
+            return self.hold_wheels(dt_s);
+        }
+        if !(self.balancing() && self.armed && self.wheels_may_drive()) {
+            self.wheels_since = None;
+            self.balance.reset();
+            self.turn.reset();
+            return [0.0; 2];
+        }
+        let since = *self.wheels_since.get_or_insert(now);
+        if since == now && matches!(self.state, State::Folding(_)) {
+            // The wheels take the robot (again): back to where it stood from where it is.
+            self.fold_return = Some((now, self.carried_forward_m()));
+        }
+        let mut wheel_torque_nm = self.wheel_law(now, dt_s);
+        if matches!(self.state, State::Folding(_)) {
+            self.ramp_in(&mut wheel_torque_nm, now.since(since));
+            self.fold_ahead_m += self.ground_speed_m_s() * dt_s;
+        }
+        wheel_torque_nm
     }
 
     /// Whether the balance law runs (where the wheels are on the ground): in the states that
@@ -355,6 +365,7 @@ impl Controller {
             self.transfer_done = false;
             self.fold_origin_x_m = None;
             self.fold_ahead_m = 0.0;
+            self.fold_return = None;
             self.fold_done_at = None;
         }
         let moving_on_wheels = matches!(

@@ -55,7 +55,7 @@
 //! `A`). So on the wheels the spin about "up" does not count as turning for `w` (its
 //! accelerations are in `a_own`), and `k_p` grows by [`EstimatorConfig::spin_kp_per_rad`] per
 //! rad/s of spin beyond [`EstimatorConfig::turn_trust_rad_s`] (so that nothing changes while
-//! the robot does not spin): at the on-the-spot turn's 2 rad/s the crossover is 4.6 rad/s,
+//! the robot does not spin): at the on-the-spot turn's 2 rad/s the crossover is 5.0 rad/s,
 //! fast against the turn, so the estimate stays where the accelerometer puts it, error and
 //! all, as the trim expects.
 //!

@@ -172,7 +172,7 @@ impl Levelling {
 
     /// Whether the legs are at shift 0, where a stand-up from the wheels starts: unfolding
     /// from under the torso, the back legs reached the ground after the front ones and tipped
-    /// the robot 8° nose up; from behind the hips, 5°.
+    /// the robot 8° nose up; from behind the hips, 6.5°.
     pub fn stowed(&self) -> bool {
         self.pose_shift == 0.0
     }

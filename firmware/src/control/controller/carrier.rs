@@ -58,7 +58,9 @@ impl Controller {
     /// Whether a robot on its wheels is not yet settled for a stand-up: it still rolls, or its
     /// body still leans more than [`STAND_LEAN_RAD`] from its balance point or pitches faster
     /// than [`STAND_STILL_RAD_S`] (a stop's brake leans it forward by up to 13°; legs unfolded
-    /// under that lean land their front feet first and stand the robot up nose-down).
+    /// under that lean land their front feet first and stand the robot up nose-down), or its
+    /// legs are not yet at the fold a stand-up starts from
+    /// ([`crate::legs::levelling::Levelling::stowed`]).
     pub(super) fn unsettled(&mut self) -> bool {
         let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;

@@ -121,16 +121,16 @@ impl Controller {
     /// a speed fed back from the remaining distance overshot by what the law lagged.
     #[inline(never)] // As `level`.
     pub(super) fn fold_return_m_s(&self, now: Tick) -> f32 {
-        let Some(since) = self.wheels_since else {
+        let Some((since, distance_m)) = self.fold_return else {
             return 0.0;
         };
         let period_s = FOLD_RETURN_MS as f32 * 1e-3;
         let t_s = now.since(since) as f32 * self.config.rate.period_s();
-        if t_s >= period_s || !self.fold_return_m.is_finite() {
+        if t_s >= period_s || !distance_m.is_finite() {
             return 0.0;
         }
         let omega = core::f32::consts::PI / period_s;
-        -self.fold_return_m * 0.5 * omega * crate::math::sin_cos(omega * t_s).0
+        -distance_m * 0.5 * omega * crate::math::sin_cos(omega * t_s).0
     }
 
     /// Which of the balance law's trim rules may learn now: from the position error only on
@@ -175,7 +175,7 @@ impl Controller {
     /// A stand-up holds the wheels from its first tick once the robot is settled on them
     /// ([`Controller::unsettled`]): balancing while the legs swing out under it, the law
     /// answered the shift of their mass with a jolt of the wheels, and the torso pitched 7–9°
-    /// on the way up (4.9° holding).
+    /// on the way up (6.5° now, holding, from the fold it stows to).
     pub(super) fn folding_on_feet(&mut self) -> bool {
         if !matches!(self.state, State::Folding(_) | State::Standing(_)) || !self.wheels_may_drive()
         {

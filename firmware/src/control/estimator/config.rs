@@ -47,7 +47,7 @@ pub struct EstimatorConfig {
     /// "Spinning").
     pub spin_kp_per_rad: f32,
     /// Time constant of the low-pass on the accelerometer's gravity share, s (40 ms, a
-    /// thirtieth of the crossover's: the wheels' speed and the IMU's reading do not line up
+    /// twentieth of the crossover's: the wheels' speed and the IMU's reading do not line up
     /// sample by sample, and their difference's jitter would fail the `|a|` test).
     pub accel_filter_s: f32,
 }

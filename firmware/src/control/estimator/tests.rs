@@ -384,12 +384,12 @@ fn a_spin_in_place_keeps_the_pitch_where_the_trim_learned_it() {
         }
         worst
     };
-    let gyro_alone = EstimatorConfig {
+    let without_spin_gain = EstimatorConfig {
         spin_kp_per_rad: 0.0,
         ..CONFIG
     };
-    let (spin, alone) = (run(&CONFIG), run(&gyro_alone));
-    println!("spinning: pitch moved {spin:.2}° from rest, {alone:.2}° on the gyro alone");
+    let (spin, alone) = (run(&CONFIG), run(&without_spin_gain));
+    println!("spinning: pitch moved {spin:.2}° from rest, {alone:.2}° without the spin gain");
     assert!(spin < 1.0, "with the spin gain: {spin:.2}°");
     assert!(
         alone > 1.0 && alone > 1.5 * spin,
