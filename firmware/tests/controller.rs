@@ -109,10 +109,7 @@ fn w_folds_the_legs_through_the_touchdown_pose_then_drives_on_the_wheels() {
 
 #[test]
 fn trot_from_the_wheels_stands_up_first() {
-    let mut bench = Bench::ready();
-    bench.send(command(TeleopMode::Fold));
-    bench.run(1_000);
-    assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+    let mut bench = Bench::on_the_wheels();
     bench.send(command(TeleopMode::TrotForward));
     bench.tick();
     assert_eq!(
@@ -135,10 +132,7 @@ fn trot_from_the_wheels_stands_up_first() {
 /// reference stays at zero (an earlier fold's return must not drive the robot again).
 #[test]
 fn a_fold_during_a_stand_up_on_the_wheels_does_not_drive() {
-    let mut bench = Bench::ready();
-    bench.send(command(TeleopMode::Fold));
-    bench.run(1_000);
-    assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+    let mut bench = Bench::on_the_wheels();
     bench.send(command(TeleopMode::Stand));
     bench.run(25);
     assert!(matches!(bench.state(), State::Standing(_)));

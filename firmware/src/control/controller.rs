@@ -410,8 +410,14 @@ impl Controller {
     }
 
     fn smooth(&mut self, rate_per_s: f32) {
+        self.smooth_toward(rate_per_s, self.goal_rad);
+    }
+
+    /// One tick of the leg targets toward `goal_rad` with the report's smoothing at
+    /// `rate_per_s`.
+    pub(super) fn smooth_toward(&mut self, rate_per_s: f32, goal_rad: Joints<f32>) {
         let smoother = Smoother::new(rate_per_s, self.config.rate);
-        for (target, goal) in self.legs_rad.iter_mut().zip(&self.goal_rad) {
+        for (target, goal) in self.legs_rad.iter_mut().zip(&goal_rad) {
             *target = smoother.step(*target, *goal);
         }
     }

@@ -30,11 +30,11 @@ pub enum Generator {
 /// the low side go deeper by `roll_m_per_rad · |roll|` and those on the high side shallower,
 /// within `limit_m` and the trot's reach (at the nominal body height the stance line cannot
 /// rise above [`Posture::trot_depth_min_m`], so only the low side pushes; with the body raised
-/// to the deepest stance, only the high side lifts). A trot on low friction slipped, rolled onto a lateral pair of feet and fell (the
-/// campaign's L: 104 of 500 runs fell, 65 % of those drawn at friction 0.6–0.8). Measured
-/// over 500 trials: L 67.0 → 83.0 %, K 64.8 → 75.0 %, X after L 93.2 → 87.8 %; 0.2 m/rad
-/// oscillated (L 81, K 52 % over 100), and levelling pitch too, or stepping ahead by the
-/// pitch, measured worse.
+/// to the deepest stance, only the high side lifts). A trot on low friction slipped, rolled
+/// onto a lateral pair of feet and fell (the campaign's L: 104 of 500 runs fell, 65 % of those
+/// drawn at friction 0.6–0.8). Measured over 500 trials: L 67.0 → 83.0 %, K 64.8 → 75.0 %,
+/// X after L 93.2 → 87.8 %; 0.2 m/rad oscillated (L 81, K 52 % over 100), and levelling pitch
+/// too, or stepping ahead by the pitch, measured worse.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BodyLevel {
     /// Stance depth per rad of roll, m/rad.

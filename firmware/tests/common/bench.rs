@@ -3,7 +3,7 @@
 //! every 5 ticks), for the step-by-step tests.
 
 use firmware::control::controller::Output;
-use firmware::control::fsm::State;
+use firmware::control::fsm::{State, WheelMotion};
 use firmware::{Config, Controller, Tick};
 use protocol::{
     AngularRate, AnyMessage, EStop, EStopAction, Imu, Joints, NodeId, ReleaseToken,
@@ -61,6 +61,15 @@ impl Bench {
         let mut bench = Self::new();
         bench.run(5);
         bench.send(command(TeleopMode::Stop));
+        bench
+    }
+
+    /// [`Bench::ready`], then folded onto the wheels and balancing in place.
+    pub fn on_the_wheels() -> Self {
+        let mut bench = Self::ready();
+        bench.send(command(TeleopMode::Fold));
+        bench.run(1_000);
+        assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
         bench
     }
 

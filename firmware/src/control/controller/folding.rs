@@ -6,7 +6,6 @@ use protocol::Joints;
 use super::Controller;
 use crate::control::fsm::{State, WheelMotion};
 use crate::control::safety::clamp_leg_targets;
-use crate::legs::smoothing::Smoother;
 use crate::legs::transfer::Transfer;
 use crate::time::Tick;
 
@@ -208,11 +207,8 @@ impl Controller {
     #[inline(never)] // As `level`.
     pub(super) fn stow_legs(&mut self) {
         if self.wheels_carry() && !self.levelling.stowed() {
-            let smoother = Smoother::new(self.config.fold_rate_per_s, self.config.rate);
             let fold_rad = self.fold_rad();
-            for (target, fold) in self.legs_rad.iter_mut().zip(&fold_rad) {
-                *target = smoother.step(*target, *fold);
-            }
+            self.smooth_toward(self.config.fold_rate_per_s, fold_rad);
         }
     }
 
@@ -222,10 +218,7 @@ impl Controller {
     /// the way and lifted the robot.
     #[inline(never)] // As `level`.
     pub(super) fn stop_fold_rad(&self) -> Joints<f32> {
-        let mut goal = self.config.levelling.family.pose(0.0);
-        let fallback = goal;
-        clamp_leg_targets(&self.config.limits, &mut goal, &fallback);
-        goal
+        self.within_limits(self.config.levelling.family.pose(0.0))
     }
 
     /// One tick of the levelling ([`crate::legs::levelling`]): balancing in place and at rest
@@ -235,12 +228,12 @@ impl Controller {
     /// after W rolled on past its 5 cm, an E-stop was not at rest within 1 s).
     #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
     pub(super) fn level(&mut self, dt_s: f32) {
-        let in_place = matches!(self.state, State::Folding(_)) && self.fold_done_at.is_some();
+        let tucked = matches!(self.state, State::Folding(_)) && self.fold_done_at.is_some();
         let fresh = self.wheels_since.is_some() && self.balance.trim_followed();
         let config = &self.config.levelling;
         if matches!(self.state, State::Standing(_)) {
             self.levelling.stow(config, dt_s);
-        } else if in_place && fresh {
+        } else if tucked && fresh {
             let balance_point_rad = self.balance.pitch_trim_rad();
             self.levelling.update(config, balance_point_rad, dt_s);
         } else {
@@ -252,9 +245,13 @@ impl Controller {
     /// (computed, not kept: the MCU's stack is measured to the byte).
     #[inline(never)] // As `level`.
     pub(super) fn fold_rad(&self) -> Joints<f32> {
-        let mut goal = self.levelling.pose(&self.config.levelling);
-        let fallback = goal;
-        clamp_leg_targets(&self.config.limits, &mut goal, &fallback);
-        goal
+        self.within_limits(self.levelling.pose(&self.config.levelling))
+    }
+
+    /// `pose` clamped into the joint ranges.
+    fn within_limits(&self, pose: Joints<f32>) -> Joints<f32> {
+        let (mut clamped, fallback) = (pose, pose);
+        clamp_leg_targets(&self.config.limits, &mut clamped, &fallback);
+        clamped
     }
 }
