@@ -199,8 +199,14 @@ impl Levelling {
         );
         let next = self.shift + rate * dt_s;
         if next.is_finite() {
+            let legs_at_shift = self.pose_shift == self.shift;
             self.shift = crate::math::clamp(next, -1.0, 1.0);
-            self.pose_shift = self.shift;
+            // After a stow the legs come back at the loop's rate, not in one tick.
+            self.pose_shift = if legs_at_shift {
+                self.shift
+            } else {
+                toward(self.pose_shift, self.shift, config.max_rate_per_s * dt_s)
+            };
         }
     }
 
@@ -295,5 +301,22 @@ mod tests {
             levelling.pose(&config),
             config.family.pose(config.start_shift)
         );
+    }
+
+    #[test]
+    fn after_a_stow_the_loop_brings_the_legs_back_at_its_rate() {
+        let config = LevellingConfig::ROBOT;
+        let mut levelling = Levelling::new(&config);
+        for _ in 0..100_u32 {
+            levelling.stow(&config, 0.01);
+        }
+        assert!(levelling.stowed());
+        levelling.update(&config, 0.0, 0.01);
+        let moved = levelling.pose_shift.abs();
+        assert!(
+            moved <= config.max_rate_per_s * 0.01 + 1e-6,
+            "the legs jumped by {moved} of the shift"
+        );
+        assert!(!levelling.stowed());
     }
 }
