@@ -37,8 +37,8 @@
 //! [`EstimatorConfig::imu_above_axle_m`] above it. `a_own` is that acceleration at the IMU
 //! (tangential and centripetal terms from `ω'` and its change). What remains is weighted:
 //! `w` is 1 while `|g|` is within [`EstimatorConfig::accel_trust`] of what the accelerometer
-//! reads at rest (its offsets move that by a few per cent: tracked slowly while the torso does
-//! not turn) and falls to 0 at [`EstimatorConfig::accel_distrust`] (impacts, a trot's bounce),
+//! reads at rest (its offsets move that by a few per cent: tracked within about a second while
+//! the torso does not turn, from the share along "up", which a sideways push does not move) and falls to 0 at [`EstimatorConfig::accel_distrust`] (impacts, a trot's bounce),
 //! and it falls likewise while the torso turns faster than
 //! [`EstimatorConfig::turn_trust_rad_s`] (on the wheels, only its tilting counts: see
 //! "Spinning"). An acceleration nobody told the filter and that
@@ -268,7 +268,7 @@ impl AttitudeEstimator {
             rate
         };
         let turn = turn_weight(config, turning);
-        self.track_rest(config, norm, dt_s, turn >= 1.0);
+        self.track_rest(config, dot(gravity, up), dt_s, turn >= 1.0);
         let weight = self.accel_weight(config, norm) * turn;
         if weight > 0.0 {
             scale(cross(scale(gravity, 1.0 / norm), up), weight)
@@ -312,12 +312,15 @@ impl AttitudeEstimator {
         own
     }
 
-    /// Follows the magnitude the accelerometer reads near g while the torso does not turn (a
-    /// chip's offsets move it by a few per cent), slowly.
-    fn track_rest(&mut self, config: &EstimatorConfig, norm: f32, dt_s: f32, quiet: bool) {
-        if quiet && near_g(config, norm) {
+    /// Follows what the accelerometer reads at rest while the torso does not turn: its
+    /// gravity share along "up", `along_m_s2`, where it is near g. A chip's offsets move it by
+    /// a few per cent, as much as the trust band, and a torso that folds onto its wheels at
+    /// once is never still long enough to measure it; a push or an untold acceleration leans
+    /// the specific force sideways, which moves its magnitude but not its share along "up".
+    fn track_rest(&mut self, config: &EstimatorConfig, along_m_s2: f32, dt_s: f32, quiet: bool) {
+        if quiet && near_g(config, along_m_s2) {
             let k = (dt_s / config.rest_s).min(1.0);
-            self.rest_m_s2 += k * (norm - self.rest_m_s2);
+            self.rest_m_s2 += k * (along_m_s2 - self.rest_m_s2);
         }
     }
 

@@ -14,8 +14,11 @@ pub struct EstimatorConfig {
     pub kp_start_per_s: f32,
     /// How long the start-up gain holds after the first sample, ms (no bias learning then).
     pub start_ms: u32,
-    /// Time constant with which the reference `|a|` at rest follows the readings near g while
-    /// the torso does not turn, s.
+    /// Time constant with which the reference `|a|` at rest follows the gravity share along
+    /// "up" while the torso does not turn, s: about a second, because a 1σ chip offset along z
+    /// already leaves the trust band, and a robot that folds onto its wheels at once gets no
+    /// still window to measure it (with 20 s the accelerometer of such a chip was ignored
+    /// through the campaign's scenarios: over 100 trials 86.6 → 89.6 %, `A` 88 → 95 %).
     pub rest_s: f32,
     /// A still window this long calibrates the gyro bias, ms.
     pub still_ms: u32,
@@ -68,7 +71,7 @@ impl EstimatorConfig {
         ki_per_s2: 0.36,
         kp_start_per_s: 2.0,
         start_ms: 1_000,
-        rest_s: 20.0,
+        rest_s: 1.0,
         still_ms: 400,
         still_rad_s: 0.02,
         still_m_s2: 0.12,
