@@ -112,7 +112,13 @@ fn foot_path(direction: Direction) -> Vec<(f32, f32)> {
 #[test]
 fn the_cartesian_foot_pushes_back_along_the_ground_and_swings_over_it() {
     let path = foot_path(Direction::Forward);
-    let (stance, swing) = path.split_at(125);
+    // The stance takes the duty's share of the 250 ticks.
+    let duty = match TrotParams::DEFAULT.generator {
+        Generator::Cartesian(path) => path.duty,
+        Generator::Sine(_) => 0.5,
+    };
+    let stance_ticks = (duty * 250.0).round() as usize;
+    let (stance, swing) = path.split_at(stance_ticks);
     for window in stance.windows(2) {
         assert!(
             (window[0].1 + 0.35).abs() < 1e-4,
@@ -120,7 +126,7 @@ fn the_cartesian_foot_pushes_back_along_the_ground_and_swings_over_it() {
         );
         assert!(window[1].0 < window[0].0, "stance pushes the foot backward");
     }
-    let stride = stance[0].0 - stance[124].0;
+    let stride = stance[0].0 - stance[stance_ticks - 1].0;
     assert!((stride - 0.08).abs() < 2e-3, "stride {stride} m");
     let apex = swing.iter().map(|p| p.1).fold(f32::MIN, f32::max);
     assert!((apex - (-0.35 + 0.04)).abs() < 1e-3, "swing apex {apex} m");
