@@ -126,7 +126,8 @@ fn standing_up_from_the_wheels_happens_in_place() {
     let before = [(0.0, TeleopMode::Stop), (0.1, TeleopMode::Fold)];
     let f = transition("stand-up from the wheels", &before, TeleopMode::Stand, 6.0);
     // 14.3 cm and 4.9° from the fold with the back legs behind the hips; from the levelled
-    // fold the legs first go back there (`Levelling::stow`): 15.2 cm, 6.5° (unfolding from the
-    // levelled fold straight away: 13.4 cm and 8.1°, past the tilt goal).
-    assert_in_place(&f, 0.16, 8.0);
+    // fold the legs first go back there (`Levelling::stow`): 11.5 cm, 6.2° (unfolding from the
+    // levelled fold straight away: 13.4 cm and 8.1°, past the tilt goal). The goal of 5 cm is
+    // not met; the bound holds what is reached.
+    assert_in_place(&f, 0.13, 8.0);
 }
