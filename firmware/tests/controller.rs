@@ -149,6 +149,34 @@ fn a_fold_during_a_stand_up_on_the_wheels_does_not_drive() {
 }
 
 #[test]
+fn a_turn_on_the_spot_brings_its_wheel_torque_in_gradually() {
+    let mut bench = Bench::on_the_wheels();
+    bench.send(command(TeleopMode::WheelRotate));
+    let differential_nm = |output: &firmware::Output| {
+        let [left, right] = output.wheel_torque_nm;
+        (right - left).abs() / 2.0
+    };
+    // A step to the full turn rate asked the turn loop for its whole torque at once, and on
+    // low friction the wheels slipped.
+    let first = bench.tick();
+    let limit_nm = CONFIG.turn.limit_nm;
+    assert!(
+        differential_nm(&first) < 0.1 * limit_nm,
+        "first tick: {} N·m",
+        differential_nm(&first)
+    );
+    // … and it does ask for the turn: the bench's wheels do not turn, so the loop's torque
+    // grows to its limit once the reference has ramped up.
+    bench.run(ms(500));
+    let later = bench.tick();
+    assert!(
+        differential_nm(&later) > 0.5 * limit_nm,
+        "after 0.5 s: {} N·m",
+        differential_nm(&later)
+    );
+}
+
+#[test]
 fn silent_feedback_safe_stops_within_fifty_milliseconds() {
     let mut bench = Bench::ready();
     bench.send(command(TeleopMode::TrotForward));

@@ -38,6 +38,10 @@ use crate::wheels::balance::{Balance, BalanceInput};
 use crate::wheels::runaway::{Runaway, RunawayInput};
 use crate::wheels::wheel::{mix, SpeedLoop};
 
+/// How fast the turn reference changes, rad/s² of wheel rate: a step to the turn's full
+/// rate asked the turn loop for its whole torque at once, and on low friction the wheels slipped
+/// (the campaign's `A`: spins stopped as runaways at friction 0.6–0.7).
+const TURN_ACCEL_RAD_S2: f32 = 8.0;
 /// The robot's controller.
 #[derive(Debug, Clone)]
 pub struct Controller {
@@ -48,6 +52,9 @@ pub struct Controller {
     trot: Trot,
     balance: Balance,
     turn: SpeedLoop,
+    /// The turn loop's reference, rad/s, slewed toward what the mode asks
+    /// ([`TURN_ACCEL_RAD_S2`]).
+    turn_ref_rad_s: f32,
     /// Smoothed leg targets, rad.
     legs_rad: Joints<f32>,
     /// Goal of the smoothing, rad (kept so a failed IK holds the previous goal).
@@ -122,6 +129,7 @@ impl Controller {
             trot,
             balance: Balance::new(config.balance),
             turn: SpeedLoop::new(config.turn),
+            turn_ref_rad_s: 0.0,
             legs_rad: Joints::splat(0.0),
             goal_rad: Joints::splat(0.0),
             levelling: Levelling::new(&config.levelling),
@@ -298,6 +306,7 @@ impl Controller {
             self.wheels_since = None;
             self.balance.reset();
             self.turn.reset();
+            self.turn_ref_rad_s = 0.0;
             return [0.0; 2];
         }
         let since = *self.wheels_since.get_or_insert(now);
@@ -339,6 +348,11 @@ impl Controller {
             && !matches!(self.state, State::Legs(LegMotion::Trot(_)));
         if entering_trot {
             self.trot.restart();
+        }
+        if next == State::Wheels(WheelMotion::Rotate) && self.state != next {
+            // A turn on the spot turns where the robot is: a position error still remembered
+            // from the fold's return was worked off during the spin and moved its centre.
+            self.balance.hold_here();
         }
         if next == State::Hold {
             // Unarmed, the targets already follow the measured positions every tick.
@@ -461,9 +475,12 @@ impl Controller {
                 self.wheel_fault_stop(now, cause, input.ground_speed_m_s);
             }
         }
+        let step = TURN_ACCEL_RAD_S2 * dt_s;
+        self.turn_ref_rad_s +=
+            crate::math::clamp(turn_ref_rad_s - self.turn_ref_rad_s, -step, step);
         let config = &self.config;
         let differential = self.turn.update(
-            turn_ref_rad_s - self.sensors.differential_wheel_rate_rad_s(),
+            self.turn_ref_rad_s - self.sensors.differential_wheel_rate_rad_s(),
             dt_s,
         );
         let (left, right) = mix(common, differential, config.wheel_torque_limit_nm);

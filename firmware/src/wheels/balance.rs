@@ -227,6 +227,13 @@ impl Balance {
         }
     }
 
+    /// Forgets the position error: the robot holds where it is now, not where the error was
+    /// counted from (a turn on the spot starts from where the robot is, as a drive does; see
+    /// [`Balance::update`]).
+    pub fn hold_here(&mut self) {
+        self.position_error_m = 0.0;
+    }
+
     /// Forgets the position error and its past torques (when the wheels take over).
     pub fn reset(&mut self) {
         self.past_nm = [0.0; DESIGN_DELAY_TICKS];
