@@ -65,10 +65,14 @@ fn corrupted_and_replayed_feedback_over_vcan_is_refused_frame_for_frame_and_the_
     // An independent receiver over exactly what the kernel carried must refuse what the
     // firmware refused: at each of the firmware's RejectCounters frames, its counts equal ours
     // as of the SYNC it answered (frames after that SYNC are not yet read by the firmware).
+    // The report goes out after the tick's commands, and on a loaded host the simulator may
+    // already have answered them with the next cycle's feedback and SYNC by the time it
+    // reaches the bus: so it answered the last SYNC before it or the one before that.
     // Ours joins the session on the controller's announcement, as any node does.
     let frames = read_candump(&log);
     let mut ours = Receiver::member(TEST_KEY);
     let mut at_sync = *ours.counters();
+    let mut before_sync = at_sync;
     let mut compared = 0;
     for (_, frame) in &frames {
         if frame.id() == MessageId::Announce.raw() {
@@ -80,9 +84,12 @@ fn corrupted_and_replayed_feedback_over_vcan_is_refused_frame_for_frame_and_the_
             if let Ok(AnyMessage::RejectCounters(theirs)) =
                 decode_frame(frame.id(), frame.data()).map(|d| d.message)
             {
-                assert_eq!(
-                    theirs.rejected, at_sync.rejected,
-                    "after {compared} reports"
+                assert!(
+                    theirs.rejected == at_sync.rejected || theirs.rejected == before_sync.rejected,
+                    "after {compared} reports: theirs {:?}, ours at the last two SYNCs {:?} and {:?}",
+                    theirs.rejected,
+                    at_sync.rejected,
+                    before_sync.rejected
                 );
                 compared += 1;
             }
@@ -90,6 +97,7 @@ fn corrupted_and_replayed_feedback_over_vcan_is_refused_frame_for_frame_and_the_
         }
         let _ = ours.receive(frame.id(), frame.data());
         if frame.id() == MessageId::Sync.raw() {
+            before_sync = at_sync;
             at_sync = *ours.counters();
         }
     }
