@@ -139,6 +139,18 @@ pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
     }
 }
 
+/// `from` moved toward `to` by at most `step` (a rate limit; a non-finite result holds
+/// `from`).
+#[inline]
+pub fn toward(from: f32, to: f32, step: f32) -> f32 {
+    let moved = from + clamp(to - from, -step, step);
+    if moved.is_finite() {
+        moved
+    } else {
+        from
+    }
+}
+
 /// `angle_rad` wrapped into −π…π.
 #[inline]
 pub fn wrap_pi(angle_rad: f32) -> f32 {

@@ -42,6 +42,7 @@ use crate::wheels::wheel::{mix, SpeedLoop};
 /// rate asked the turn loop for its whole torque at once, and on low friction the wheels slipped
 /// (the campaign's `A`: spins stopped as runaways at friction 0.6–0.7).
 const TURN_ACCEL_RAD_S2: f32 = 8.0;
+
 /// The robot's controller.
 #[derive(Debug, Clone)]
 pub struct Controller {
@@ -475,9 +476,11 @@ impl Controller {
                 self.wheel_fault_stop(now, cause, input.ground_speed_m_s);
             }
         }
-        let step = TURN_ACCEL_RAD_S2 * dt_s;
-        self.turn_ref_rad_s +=
-            crate::math::clamp(turn_ref_rad_s - self.turn_ref_rad_s, -step, step);
+        self.turn_ref_rad_s = crate::math::toward(
+            self.turn_ref_rad_s,
+            turn_ref_rad_s,
+            TURN_ACCEL_RAD_S2 * dt_s,
+        );
         let config = &self.config;
         let differential = self.turn.update(
             self.turn_ref_rad_s - self.sensors.differential_wheel_rate_rad_s(),

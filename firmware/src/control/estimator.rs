@@ -38,8 +38,9 @@
 //! (tangential and centripetal terms from `ω'` and its change). What remains is weighted:
 //! `w` is 1 while `|g|` is within [`EstimatorConfig::accel_trust`] of what the accelerometer
 //! reads at rest (its offsets move that by a few per cent: tracked within about a second while
-//! the torso does not turn, from the share along "up", which a sideways push does not move) and falls to 0 at [`EstimatorConfig::accel_distrust`] (impacts, a trot's bounce),
-//! and it falls likewise while the torso turns faster than
+//! the torso does not turn, from the share along "up", which a sideways push does not move)
+//! and falls to 0 at [`EstimatorConfig::accel_distrust`] (impacts, a trot's bounce), and it
+//! falls likewise while the torso turns faster than
 //! [`EstimatorConfig::turn_trust_rad_s`] (on the wheels, only its tilting counts: see
 //! "Spinning"). An acceleration nobody told the filter and that
 //! keeps `|a|` near g (a push on the legs) leans the estimate toward `atan(a/g)` with the

@@ -7,7 +7,7 @@
 //!   z      swing (the rest of the cycle): x from −L/2 to +L/2, z lifts by h·sin(πs)
 //!   ^     .-----------.
 //!   |    /             \
-//!  −d  +L/2 <—————— −L/2    stance (the duty's share of the cycle): x from +L/2 to −L/2 at z = −d
+//!  −d  +L/2 <—————— −L/2    stance (the duty's share): x from +L/2 to −L/2 at z = −d
 //! ```
 //!
 //! # Duty
@@ -44,8 +44,7 @@ pub struct FootTrajectory {
 
 impl FootTrajectory {
     /// 8 cm stride, 4 cm clearance, centred 3 cm ahead of the hip, on the ground 55 % of the
-    /// cycle (module docs, "Duty"). Centred under the hip the
-    /// robot trotted forward (1.3 m in 8 s) but not backward (0.09 m): its knees bend one way,
+    /// cycle (module docs, "Duty"). Centred under the hip the robot trotted forward (1.3 m in 8 s) but not backward (0.09 m): its knees bend one way,
     /// so a leg pushes unevenly fore and aft of the hip. Measured in the simulator over 8 s,
     /// forward / backward: centre 0 → 1.30 / 0.09 m, +1.5 cm → 1.21 / 0.60 m, +3 cm → 0.96 /
     /// 0.88 m, +4.5 cm → 0.65 / 1.18 m; +3 cm walks both ways alike.
@@ -58,8 +57,8 @@ impl FootTrajectory {
 
     /// The foot position `(x_m, z_m)` at `phase` for a stance line `depth_m` below the hip,
     /// with the stride scaled by `scale` (0…1, clamped). Stance takes the first
-    /// [`FootTrajectory::duty`] of the cycle and pushes the foot backward, so the body moves forward; run the phase backward
-    /// ([`Phase::reversed`]) to walk backward.
+    /// [`FootTrajectory::duty`] of the cycle and pushes the foot backward, so the body moves
+    /// forward; run the phase backward ([`Phase::reversed`]) to walk backward.
     pub fn foot(&self, phase: Phase, depth_m: f32, scale: f32) -> (f32, f32) {
         let scale = crate::math::clamp(scale, 0.0, 1.0);
         let half = 0.5 * self.step_length_m * scale;

@@ -28,7 +28,7 @@
 use protocol::{Joints, Leg};
 
 use crate::legs::kinematics::LegJoints;
-use crate::math::deg_to_rad;
+use crate::math::{deg_to_rad, toward};
 
 /// The fold poses along the shift.
 ///
@@ -213,16 +213,6 @@ impl Levelling {
     /// The fold pose the legs are at.
     pub fn pose(&self, config: &LevellingConfig) -> Joints<f32> {
         config.family.pose(self.pose_shift)
-    }
-}
-
-/// `from` moved toward `to` by at most `step` (NaN steps hold).
-fn toward(from: f32, to: f32, step: f32) -> f32 {
-    let moved = from + crate::math::clamp(to - from, -step, step);
-    if moved.is_finite() {
-        moved
-    } else {
-        from
     }
 }
 
