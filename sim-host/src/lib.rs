@@ -22,4 +22,5 @@ pub mod error_chain;
 pub mod faults;
 pub mod output;
 pub mod robot;
+pub mod scene;
 pub mod session;

@@ -15,6 +15,10 @@
 //! body_height_m = 0.0         # optional, −0.10…+0.12 (default 0)
 //! speed_scale_pct = 100       # optional, 0…100 (default 100)
 //! label = "drive"             # optional name of the segment in the summary
+//!
+//! [scene]                     # optional: the simulator's ground (sim-host reads it)
+//! kind = "step"
+//! height_m = 0.06
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -87,6 +91,10 @@ struct RawScenario {
     duration_s: Spanned<f64>,
     #[serde(default)]
     step: Vec<Spanned<RawStep>>,
+    /// The simulator's ground (`sim_host::scene`), which the simulator reads and checks; an
+    /// operator's plan does not depend on it.
+    #[allow(dead_code)]
+    scene: Option<toml::Value>,
 }
 
 #[derive(Debug, Deserialize)]

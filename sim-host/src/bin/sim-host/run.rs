@@ -14,6 +14,7 @@ use sim_host::robot::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
 use sim_host::robot::plant::{DriveRatings, Plant};
 use sim_host::robot::sensing::DriveSensing;
 use sim_host::robot::variation::Variation;
+use sim_host::scene::Scene;
 use sim_host::session::{self, BusChoice, Clock, FrameSettings, SegmentSpec, SessionConfig};
 use teleop_core::scenario::{mode_name, Scenario};
 use teleop_core::scripted::PlanStep;
@@ -67,12 +68,23 @@ impl ClockArg {
     }
 }
 
-#[derive(Debug, Clone, Copy, ValueEnum)]
-pub(crate) enum Scene {
-    /// Flat ground.
-    Flat,
-    /// A 6 cm step at 1.5 m and a 10° ramp from 3 m.
+/// The ground: the shipped obstacle file, or a scene made from parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum SceneArg {
+    /// `models/obstacles.xml`: a 6 cm step at 1.5 m and a 10° ramp from 3 m.
     Obstacles,
+    /// A scene of `sim_host::scene`.
+    Made(Scene),
+}
+
+/// `--scene`: `obstacles`, or `KIND[:KEY=VALUE,…]` of [`Scene::from_arg`].
+fn parse_scene(text: &str) -> Result<SceneArg, String> {
+    if text.trim() == "obstacles" {
+        return Ok(SceneArg::Obstacles);
+    }
+    Scene::from_arg(text)
+        .map(SceneArg::Made)
+        .map_err(|e| e.to_string())
 }
 
 #[derive(Debug, clap::Args)]
@@ -94,10 +106,13 @@ pub(crate) struct RunArgs {
     /// Folder for telemetry.csv, bus.log (candump format) and the PNG plots.
     #[arg(long, default_value = "out/sim")]
     pub(crate) out: PathBuf,
-    /// Which shipped scene to load.
-    #[arg(long, value_enum, default_value = "flat")]
-    pub(crate) scene: Scene,
-    /// An MJCF file instead of a shipped scene.
+    /// The ground: `flat`, `step`, `flight`, `ramp` or `course`, each with its keys
+    /// (`step:height_m=0.08,riser_x_m=1.5`; docs/simulator.md lists them), or `obstacles` (the
+    /// shipped obstacles.xml). Overrides a scenario's `[scene]`; the scene's MJCF is written
+    /// to `--out` as scene.xml. Default: the scenario's scene, else flat.
+    #[arg(long, value_parser = parse_scene)]
+    pub(crate) scene: Option<SceneArg>,
+    /// The robot's MJCF (a scene is built around it) instead of the shipped model.
     #[arg(long)]
     pub(crate) model: Option<PathBuf>,
     /// Operator command at a time, `SECONDS:MODE` with MODE one of the report's keys W S A L K X
@@ -248,7 +263,8 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
             "--duration-s {duration_s} must be a positive number of seconds"
         ));
     }
-    let config = session_config(&args, scenario.as_ref(), duration_s);
+    let model = model_path(&args)?;
+    let config = session_config(&args, scenario.as_ref(), duration_s, model);
     tracing::info!(model = %config.model.display(), bus = %args.bus, "starting");
     let report = session::run(&config).map_err(|e| match e {
         session::SessionError::Bus(bus) if bus.is_missing_interface() => {
@@ -259,8 +275,40 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
     crate::report::print(&args, scenario.as_ref(), &report)
 }
 
+/// The MJCF the run loads: `--scene` (or else the scenario's `[scene]`) around `--model` (or
+/// the shipped robot), written to `--out` as scene.xml; the robot's own file on flat ground.
+fn model_path(args: &RunArgs) -> Result<PathBuf, String> {
+    let robot = args
+        .model
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(DEFAULT_MODEL));
+    let from_scenario = match &args.scenario {
+        Some(path) if args.scene.is_none() => {
+            let text = std::fs::read_to_string(path)
+                .map_err(|e| format!("cannot read the scenario {}: {e}", path.display()))?;
+            Scene::from_scenario(path, &text).map_err(|e| e.to_string())?
+        }
+        _ => None,
+    };
+    match args.scene.or(from_scenario.map(SceneArg::Made)) {
+        None | Some(SceneArg::Made(Scene::Flat)) => Ok(robot),
+        Some(SceneArg::Obstacles) if args.model.is_none() => Ok(PathBuf::from(OBSTACLES_MODEL)),
+        Some(SceneArg::Obstacles) => Err(
+            "--scene obstacles is the shipped robot's file; with --model give a made scene (step, flight, ramp, course)".into(),
+        ),
+        Some(SceneArg::Made(scene)) => {
+            sim_host::scene::mjcf::write(&scene, &robot, &args.out).map_err(|e| e.to_string())
+        }
+    }
+}
+
 /// The session `args` (and the scenario, if one was given) describe.
-fn session_config(args: &RunArgs, scenario: Option<&Scenario>, duration_s: f64) -> SessionConfig {
+fn session_config(
+    args: &RunArgs,
+    scenario: Option<&Scenario>,
+    duration_s: f64,
+    model: PathBuf,
+) -> SessionConfig {
     let (teleop_plan, segments) = match scenario {
         Some(s) => (
             s.plan(),
@@ -275,12 +323,6 @@ fn session_config(args: &RunArgs, scenario: Option<&Scenario>, duration_s: f64) 
         ),
         None => (args.drive.clone(), Vec::new()),
     };
-    let model = args.model.clone().unwrap_or_else(|| {
-        PathBuf::from(match args.scene {
-            Scene::Flat => DEFAULT_MODEL,
-            Scene::Obstacles => OBSTACLES_MODEL,
-        })
-    });
     let bus = match args.bus.as_str() {
         "inproc" => BusChoice::Inproc,
         ifname => BusChoice::SocketCan(ifname.to_owned()),
