@@ -2,6 +2,7 @@
 
 use crate::control::estimator::EstimatorConfig;
 use crate::control::stop::StopConfig;
+use crate::legs::blocked::BlockedConfig;
 use crate::legs::gait::TrotParams;
 use crate::legs::kinematics::LegGeometry;
 use crate::legs::levelling::LevellingConfig;
@@ -84,6 +85,8 @@ pub struct Config {
     pub stop: StopConfig,
     /// When the wheels count as stalled or running away.
     pub runaway: RunawayConfig,
+    /// When the trot counts as blocked by what it cannot step over.
+    pub blocked: BlockedConfig,
 }
 
 /// Per-wheel torque limit of the robot, N·m.
@@ -131,6 +134,7 @@ impl Config {
         attitude: EstimatorConfig::ROBOT,
         stop: StopConfig::ROBOT,
         runaway: RunawayConfig::ROBOT,
+        blocked: BlockedConfig::ROBOT,
     };
 
     /// This configuration at another control rate (gains are per second, so only the tick

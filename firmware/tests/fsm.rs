@@ -46,6 +46,7 @@ fn all_events() -> Vec<Event> {
     events.extend([
         Event::TeleopLost,
         Event::LinkDegraded,
+        Event::LegBlocked,
         Event::PoseReached,
         Event::EStopLatch,
         Event::EStopClear,
@@ -71,6 +72,7 @@ fn the_documented_table_row_by_row() {
         (Legs(TROT_F), req(TeleopMode::Stop), Legs(LegMotion::Stand)),
         (Legs(TROT_F), Event::TeleopLost, Legs(LegMotion::Stand)),
         (Legs(TROT_F), Event::LinkDegraded, Legs(LegMotion::Stand)),
+        (Legs(TROT_F), Event::LegBlocked, Legs(LegMotion::Stand)),
         (
             Legs(LegMotion::Stand),
             req(TeleopMode::TrotBackward),

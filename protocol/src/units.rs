@@ -241,6 +241,10 @@ wire_flags!(
         /// The robot moved away from the speed reference, or the balance law stayed saturated
         /// (a centre of mass off its trim, a push it cannot take): braked and set down.
         RUNAWAY = 11 => "runaway",
+        /// The trot's leading feet ended their swings behind where they were sent, swing after
+        /// swing (a step or a wall they cannot clear): the robot stopped and stands; cleared by
+        /// the operator's next request.
+        LEG_BLOCKED = 12 => "leg_blocked",
     }
 );
 

@@ -121,6 +121,7 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
                 "awaiting_stop",
                 "wheel_stall",
                 "runaway",
+                "leg_blocked",
             ];
             for (bit, flag) in flags.iter().enumerate() {
                 put(

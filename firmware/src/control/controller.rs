@@ -11,6 +11,7 @@
 //! 4. the legs' targets move toward the goal with the report's smoothing;
 //! 5. every output is clamped to the joint and torque limits and made finite.
 
+mod blocked;
 mod carrier;
 mod folding;
 mod status;
@@ -27,6 +28,7 @@ use crate::control::safety::{clamp_leg_targets, clamp_wheel_torques};
 use crate::control::sensors::Sensors;
 use crate::control::stop::Stop;
 use crate::control::teleop::Teleop;
+use crate::legs::blocked::BlockedSwings;
 use crate::legs::gait::Trot;
 use crate::legs::kinematics::LegJoints;
 use crate::legs::levelling::Levelling;
@@ -111,6 +113,9 @@ pub struct Controller {
     /// Ground speed of the wheels last tick, m/s (`None` off the wheels): its change is the
     /// acceleration the attitude estimator takes out of the accelerometer's reading.
     last_ground_m_s: Option<f32>,
+    /// The trot's blocked swings, and whether a blocked trot stopped the robot (reported
+    /// until the operator's next request; see [`crate::legs::blocked`]).
+    blocked: (BlockedSwings, bool),
 }
 
 impl Controller {
@@ -155,6 +160,7 @@ impl Controller {
             fold_done_at: None,
             stopped_on_wheels: false,
             last_ground_m_s: None,
+            blocked: (BlockedSwings::new(), false),
         })
     }
 
@@ -276,6 +282,7 @@ impl Controller {
         }
         let mut wheel_torque_nm = self.wheel_torques(now, dt_s);
         self.level(dt_s);
+        self.watch_swings();
         if matches!(self.state, State::Legs(LegMotion::Trot(_))) {
             self.trot.advance();
         }
@@ -323,24 +330,11 @@ impl Controller {
         wheel_torque_nm
     }
 
-    /// Whether the balance law runs (where the wheels are on the ground): in the states that
-    /// carry the robot on its wheels, and in `EStop` until the controlled stop cuts the torque.
-    fn balancing(&self) -> bool {
-        match self.state {
-            State::EStop | State::Fault => self.stop.is_some_and(|stop| !stop.off()),
-            state => state.balancing(),
-        }
-    }
-
-    /// Ground speed of the axle, m/s: the wheels' joint rate is relative to the body, so the
-    /// body's pitch rate is added back.
-    fn ground_speed_m_s(&self) -> f32 {
-        let r = self.config.balance.wheel_radius_m;
-        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
-        r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s)
-    }
-
     fn apply(&mut self, event: Event) {
+        if matches!(event, Event::Request(_)) {
+            // The operator has seen the stop and asks for something: the report has served.
+            self.blocked.1 = false;
+        }
         let next = self.state.next(event);
         if next == self.state {
             return;
@@ -349,6 +343,7 @@ impl Controller {
             && !matches!(self.state, State::Legs(LegMotion::Trot(_)));
         if entering_trot {
             self.trot.restart();
+            self.blocked.0.reset();
         }
         if next == State::Wheels(WheelMotion::Rotate) && self.state != next {
             // A turn on the spot turns where the robot is: a position error still remembered

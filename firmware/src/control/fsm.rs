@@ -6,20 +6,20 @@
 //!
 //! # Transition table
 //!
-//! `Request(·)` is an operator request (teleop frame); `TeleopLost` and `LinkDegraded` are
-//! stop requests the controller makes itself. `Legs(m)` and `Wheels(m)` are the
+//! `Request(·)` is an operator request (teleop frame); `TeleopLost`, `LinkDegraded` and
+//! `LegBlocked` are stop requests the controller makes itself. `Legs(m)` and `Wheels(m)` are the
 //! steady states, `Standing(m)` / `Folding(m)` the transitions that end in them on `PoseReached`.
 //! `—` means the event leaves the state unchanged.
 //!
-//! | state ↓ / event →  | Stop (X), `TeleopLost`, `LinkDegraded` | Stand          | Trot d (L/K)      | Fold             | Wheel w (W/S/A)   | `PoseReached` |
-//! |--------------------|----------------------------------------|----------------|-------------------|------------------|-------------------|---------------|
-//! | `Hold`             | —                                      | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | —             |
-//! | `Legs(_)`          | Legs(Stand)                            | Legs(Stand)    | Legs(Trot d)      | Folding(Balance) | Folding(w)        | —             |
-//! | `Standing(_)`      | Standing(Stand)                        | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Legs(m)       |
-//! | `Folding(_)`       | Folding(Balance)                       | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Wheels(m)     |
-//! | `Wheels(_)`        | Wheels(Balance)                        | Standing(Stand)| Standing(Trot d)  | —                | Wheels(w)         | —             |
-//! | `EStop`            | —                                      | —              | —                 | —                | —                 | —             |
-//! | `Fault`            | —                                      | —              | —                 | —                | —                 | —             |
+//! | state ↓ / event →  | Stop (X), `TeleopLost`, `LinkDegraded`, `LegBlocked` | Stand          | Trot d (L/K)      | Fold             | Wheel w (W/S/A)   | `PoseReached` |
+//! |--------------------|----------------------------------------------------|----------------|-------------------|------------------|-------------------|---------------|
+//! | `Hold`             | —                                                    | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | —             |
+//! | `Legs(_)`          | Legs(Stand)                                          | Legs(Stand)    | Legs(Trot d)      | Folding(Balance) | Folding(w)        | —             |
+//! | `Standing(_)`      | Standing(Stand)                                      | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Legs(m)       |
+//! | `Folding(_)`       | Folding(Balance)                                     | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Wheels(m)     |
+//! | `Wheels(_)`        | Wheels(Balance)                                      | Standing(Stand)| Standing(Trot d)  | —                | Wheels(w)         | —             |
+//! | `EStop`            | —                                                    | —              | —                 | —                | —                 | —             |
+//! | `Fault`            | —                                                    | —              | —                 | —                | —                 | —             |
 //!
 //! Events that reach every state alike:
 //!
@@ -93,6 +93,9 @@ pub enum Event {
     /// The link monitor found the bus losing too many frames: treated as a stop request (a
     /// controlled stop on the legs or the wheels, not a fault that drops the robot).
     LinkDegraded,
+    /// The trot's leading feet could not finish their swings ([`crate::legs::blocked`]):
+    /// treated as a stop request (the robot stands on four legs).
+    LegBlocked,
     /// The legs arrived at the pose of the running transition.
     PoseReached,
     /// An E-stop frame asked to latch.
@@ -122,7 +125,9 @@ impl State {
             (State::Standing(motion), Event::PoseReached) => State::Legs(motion),
             (State::Folding(motion), Event::PoseReached) => State::Wheels(motion),
             (_, Event::PoseReached) => self,
-            (_, Event::TeleopLost | Event::LinkDegraded) => self.on_request(TeleopMode::Stop),
+            (_, Event::TeleopLost | Event::LinkDegraded | Event::LegBlocked) => {
+                self.on_request(TeleopMode::Stop)
+            }
             (_, Event::Request(mode)) => self.on_request(mode),
         }
     }

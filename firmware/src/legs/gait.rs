@@ -162,6 +162,18 @@ impl Trot {
         base.shifted(pair_offset(leg))
     }
 
+    /// How far `leg`'s foot is through its swing now, walking in `direction` (0 at lift-off,
+    /// toward 1 at touchdown), or `None` while it stands: the swing is the cycle past the
+    /// stance share ([`FootTrajectory::duty`]; the report's sinusoids lift for half of it).
+    pub fn swing_share(&self, leg: Leg, direction: Direction) -> Option<f32> {
+        let duty = match self.params.generator {
+            Generator::Cartesian(path) => crate::math::clamp(path.duty, 0.5, 0.9),
+            Generator::Sine(_) => 0.5,
+        };
+        let fraction = self.leg_phase(leg, direction).fraction();
+        (fraction >= duty).then(|| (fraction - duty) / (1.0 - duty))
+    }
+
     /// Joint targets of all four legs (in [`Leg::ALL`] order) at the present phase, for a
     /// stance `depth_m` below the hips, a stride scaled by `scale` (0…1) and the body at
     /// `attitude` ([`BodyLevel`]).

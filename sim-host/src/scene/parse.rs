@@ -177,7 +177,7 @@ fn build(kind: &str, at: &str, given: BTreeMap<String, Given>) -> Result<Scene, 
             let d = Step::DEFAULT;
             let step = Step {
                 height_m: keys.number("height_m", d.height_m, [0.005, 0.3])?,
-                riser_x_m: keys.number("riser_x_m", d.riser_x_m, [0.5, 50.0])?,
+                riser_x_m: keys.number("riser_x_m", d.riser_x_m, [0.4, 50.0])?,
                 depth_m: keys.number("depth_m", d.depth_m, [0.1, 50.0])?,
             };
             (Scene::Step(step), "height_m, riser_x_m, depth_m")
@@ -189,7 +189,7 @@ fn build(kind: &str, at: &str, given: BTreeMap<String, Given>) -> Result<Scene, 
                 rise_m: keys.number("rise_m", d.rise_m, [0.005, 0.3])?,
                 count: count as u32,
                 tread_m: keys.number("tread_m", d.tread_m, [0.1, 5.0])?,
-                riser_x_m: keys.number("riser_x_m", d.riser_x_m, [0.5, 50.0])?,
+                riser_x_m: keys.number("riser_x_m", d.riser_x_m, [0.4, 50.0])?,
                 top_depth_m: keys.number("top_depth_m", d.top_depth_m, [0.1, 50.0])?,
             };
             let known = "rise_m, count, tread_m, riser_x_m, top_depth_m";
@@ -199,7 +199,7 @@ fn build(kind: &str, at: &str, given: BTreeMap<String, Given>) -> Result<Scene, 
             let d = Ramp::DEFAULT;
             let ramp = Ramp {
                 angle_deg: keys.number("angle_deg", d.angle_deg, [0.5, 30.0])?,
-                start_x_m: keys.number("start_x_m", d.start_x_m, [0.5, 50.0])?,
+                start_x_m: keys.number("start_x_m", d.start_x_m, [0.4, 50.0])?,
                 length_m: keys.number("length_m", d.length_m, [0.1, 10.0])?,
                 top_depth_m: keys.number("top_depth_m", d.top_depth_m, [0.1, 50.0])?,
             };

@@ -18,6 +18,23 @@ const STAND_LEAN_RAD: f32 = 0.08;
 const STAND_STILL_RAD_S: f32 = 0.3;
 
 impl Controller {
+    /// Whether the balance law runs (where the wheels are on the ground): in the states that
+    /// carry the robot on its wheels, and in `EStop` until the controlled stop cuts the torque.
+    pub(super) fn balancing(&self) -> bool {
+        match self.state {
+            State::EStop | State::Fault => self.stop.is_some_and(|stop| !stop.off()),
+            state => state.balancing(),
+        }
+    }
+
+    /// Ground speed of the axle, m/s: the wheels' joint rate is relative to the body, so the
+    /// body's pitch rate is added back.
+    pub(super) fn ground_speed_m_s(&self) -> f32 {
+        let r = self.config.balance.wheel_radius_m;
+        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s)
+    }
+
     /// What the attitude estimator should know of the torso's own acceleration this tick: on
     /// the wheels while the balance law drives them, the change of the ground speed
     /// `r (ω + θ̇)` over the tick. Run first in the tick; on the legs it costs no kinematics.

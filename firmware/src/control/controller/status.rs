@@ -23,6 +23,9 @@ impl Controller {
             faults = faults.with(FaultFlags::LINK_DEGRADED);
         }
         faults = faults.with(self.wheel_fault);
+        if self.blocked.1 {
+            faults = faults.with(FaultFlags::LEG_BLOCKED);
+        }
         if self.teleop.interlocked() {
             faults = faults.with(FaultFlags::AWAITING_STOP);
         }

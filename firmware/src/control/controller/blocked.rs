@@ -1,0 +1,44 @@
+//! The trot's watch for what it cannot step over ([`crate::legs::blocked`]): the front feet's
+//! swings compared, late in each, with where the drives' encoders put the feet.
+
+use protocol::Leg;
+
+use super::Controller;
+use crate::control::fsm::{Direction, Event, LegMotion, State};
+use crate::legs::blocked::lag_m;
+use crate::legs::kinematics::LegJoints;
+
+impl Controller {
+    /// One tick of the watch, walking forward, before the trot's phase advances: a front foot
+    /// that passes [`crate::legs::blocked::BlockedConfig::at_swing`] of its swing with this
+    /// tick is measured against its target; a leg blocked swing after swing stops the trot
+    /// ([`Event::LegBlocked`]: the robot stands on four legs) and the controller reports
+    /// [`protocol::FaultFlags::LEG_BLOCKED`] until the operator's next request.
+    #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
+    pub(super) fn watch_swings(&mut self) {
+        // Walking forward only (see `crate::legs::blocked`, the backward trot's swings).
+        let direction = Direction::Forward;
+        if self.state != State::Legs(LegMotion::Trot(direction)) {
+            return;
+        }
+        let (leading, sign) = ([Leg::Fl, Leg::Fr], 1.0);
+        let config = self.config.blocked;
+        let mut next = self.trot;
+        next.advance();
+        for leg in leading {
+            let now = self.trot.swing_share(leg, direction).unwrap_or(0.0);
+            let after = next.swing_share(leg, direction).unwrap_or(0.0);
+            if !(now < config.at_swing && after >= config.at_swing) {
+                continue;
+            }
+            let target = LegJoints::from_array(*self.legs_rad.leg(leg));
+            let measured = LegJoints::from_array(*self.sensors.joint_position_rad.leg(leg));
+            let lag = lag_m(&self.config.geometry, &target, &measured, sign);
+            if self.blocked.0.swing_measured(&config, leg, lag) {
+                self.blocked.1 = true;
+                self.apply(Event::LegBlocked);
+                return;
+            }
+        }
+    }
+}

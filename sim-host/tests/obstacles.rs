@@ -1,0 +1,163 @@
+//! A trot into a step it cannot clear (`firmware::legs::blocked`): the robot stops, stands and
+//! reports `leg_blocked`, never falls or marches on against the riser; on flat ground the watch
+//! never stops a trot. Seeded randomized trials: each trial is one of the campaign's robots as
+//! built (`campaign::draw`, drives rated), a riser height and an approach distance.
+//!
+//! `cargo test --release -p sim-host --test obstacles -- --nocapture` prints the figures.
+
+use std::path::{Path, PathBuf};
+
+use firmware::control::fsm::{LegMotion, State};
+use host_can::fault_plan::Faults;
+use protocol::{FaultFlags, TeleopMode};
+use sim_host::campaign::draw::{Draw, Draws};
+use sim_host::campaign::Drives;
+use sim_host::faults::rig::{Rig, PERIOD_US};
+use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::robot::physics::Physics;
+use sim_host::scene::{mjcf, Scene, Step};
+use teleop_core::scripted::PlanStep;
+
+/// The front feet stand this far ahead of the torso's centre, m (the stance's 3 cm ahead of
+/// the hips at 0.22 m, and the foot's radius).
+const FEET_AHEAD_M: f64 = 0.28;
+
+/// The operator's STOP after the run, s: it clears the report.
+const STOP_AT_S: f64 = 20.0;
+
+fn scene_file(scene: &Scene, name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("obstacles")
+        .join(name);
+    mjcf::write(scene, Path::new(DEFAULT_MODEL), &dir).unwrap()
+}
+
+/// Whether any part of the robot touches the geom `name`.
+fn touches(physics: &Physics, name: &str) -> bool {
+    let id = physics
+        .model()
+        .name_to_id(mujoco_rs::wrappers::mj_model::MjtObjBase::mjOBJ_GEOM, name)
+        .and_then(|id| i32::try_from(id).ok());
+    physics
+        .data()
+        .contact()
+        .iter()
+        .any(|c| Some(c.geom1) == id || Some(c.geom2) == id)
+}
+
+/// What a trot toward a step did.
+#[derive(Debug, Default)]
+struct Figures {
+    seed: u64,
+    height_m: f64,
+    approach_m: f64,
+    /// First touch of the step, s.
+    contact_s: Option<f64>,
+    /// First cycle reporting `leg_blocked`, s, and the state then.
+    blocked: Option<(f64, Option<State>)>,
+    /// Torso x range from the report to the STOP, m.
+    after_m: f64,
+    max_tilt_deg: f64,
+    fell: bool,
+    /// Whether the report was gone after the operator's STOP.
+    cleared: bool,
+}
+
+/// Stand, then L toward a `height_m` step whose riser is `approach_m` ahead of the front feet,
+/// on the robot of campaign seed `seed`; STOP at [`STOP_AT_S`].
+fn trot_into_step(seed: u64, height_m: f64, approach_m: f64) -> Figures {
+    let scene = Scene::Step(Step {
+        height_m,
+        riser_x_m: FEET_AHEAD_M + approach_m,
+        depth_m: 1.2,
+    });
+    let path = scene_file(&scene, &format!("seed-{seed}"));
+    let plan = vec![
+        PlanStep::at(0.0, TeleopMode::Stand),
+        PlanStep::at(1.0, TeleopMode::TrotForward),
+        PlanStep::at(STOP_AT_S, TeleopMode::Stop),
+    ];
+    let plant = Draws::of(seed).plant(Drives::Rated.ratings());
+    let faults = Faults::default();
+    let mut rig = Rig::with_plant(&path, plan, &faults, &faults, plant).unwrap();
+    let mut f = Figures {
+        seed,
+        height_m,
+        approach_m,
+        ..Figures::default()
+    };
+    let mut x_range = [f64::MAX, f64::MIN];
+    while rig.stats().cycles * PERIOD_US < ((STOP_AT_S + 1.0) * 1e6) as u64 {
+        rig.step().unwrap();
+        let t = rig.time_s();
+        let record = rig.records().last().unwrap().clone();
+        f.max_tilt_deg = f.max_tilt_deg.max(record.tilt_deg);
+        f.fell |= record.fallen();
+        if f.contact_s.is_none() && touches(rig.sim().physics(), "step") {
+            f.contact_s = Some(t);
+        }
+        let reported = record.faults.contains(FaultFlags::LEG_BLOCKED);
+        if reported && f.blocked.is_none() {
+            f.blocked = Some((t, record.state));
+        }
+        if f.blocked.is_some() && t < STOP_AT_S {
+            let x = rig.sim().physics().torso().pos_m[0];
+            x_range = [x_range[0].min(x), x_range[1].max(x)];
+        }
+        f.cleared = t > STOP_AT_S + 0.5 && !reported;
+    }
+    f.after_m = x_range[1] - x_range[0];
+    f
+}
+
+#[test]
+fn a_trot_into_a_step_it_cannot_clear_stops_and_says_why() {
+    const TRIALS: u64 = 16;
+    let mut stopped = 0;
+    for seed in 0..TRIALS {
+        // The approach: 0.2–0.6 m, the height ±1 cm.
+        let mut draw = Draw::new(seed ^ 0x0b57_ac1e);
+        let approach_m = 0.2 + 0.4 * draw.unit();
+        let height_m = 0.10 + 0.02 * (draw.unit() - 0.5);
+        let f = trot_into_step(seed, height_m, approach_m);
+        println!(
+            "MEASURED seed {}, {:.3} m step {:.2} m ahead: {f:?}",
+            f.seed, f.height_m, f.approach_m
+        );
+        let contact_s = f.contact_s.expect("never reached the step");
+        assert!(!f.fell, "{f:?}");
+        assert!(f.max_tilt_deg < 20.0, "{f:?}");
+        let (blocked_s, state) = f.blocked.expect("never reported");
+        assert!(blocked_s - contact_s < 8.0, "{f:?}");
+        assert_eq!(state, Some(State::Legs(LegMotion::Stand)), "{f:?}");
+        assert!(f.after_m < 0.10, "{f:?}");
+        assert!(f.cleared, "{f:?}");
+        stopped += 1;
+    }
+    println!("MEASURED stopped with leg_blocked: {stopped} of {TRIALS}");
+}
+
+#[test]
+fn on_flat_ground_the_watch_never_stops_a_trot() {
+    let path = scene_file(&Scene::Flat, "flat");
+    for seed in 0..8 {
+        for mode in [TeleopMode::TrotForward, TeleopMode::TrotBackward] {
+            let plan = vec![
+                PlanStep::at(0.0, TeleopMode::Stand),
+                PlanStep::at(1.0, mode),
+            ];
+            let plant = Draws::of(seed).plant(Drives::Rated.ratings());
+            let faults = Faults::default();
+            let mut rig = Rig::with_plant(&path, plan, &faults, &faults, plant).unwrap();
+            rig.run_until(25.0).unwrap();
+            let blocked = rig
+                .records()
+                .iter()
+                .filter(|r| r.faults.contains(FaultFlags::LEG_BLOCKED))
+                .count();
+            let x = rig.sim().physics().torso().pos_m[0];
+            println!("MEASURED seed {seed} {mode:?} 24 s on flat ground: {x:.2} m, {blocked} cycles blocked");
+            assert_eq!(blocked, 0, "seed {seed} {mode:?}");
+        }
+    }
+}
