@@ -1,6 +1,7 @@
 //! The stall and runaway detector in the closed loop (`firmware::wheels::runaway`): driving W
 //! into a step the wheels cannot climb raises a stall fault and sets the robot down against
-//! the step, and nothing runs away.
+//! the step, and nothing runs away — on the robot as drawn, and in seeded randomized trials
+//! over the campaign's robots as built and the distance to the step.
 //!
 //! `cargo test -p sim-host --test stall -- --nocapture` prints the figures. Lockstep is
 //! deterministic, so they repeat exactly.
@@ -10,7 +11,12 @@ use std::path::Path;
 use firmware::control::fsm::State;
 use host_can::fault_plan::Faults;
 use protocol::{FaultFlags, TeleopMode};
+use sim_host::campaign::draw::{Draw, Draws};
+use sim_host::campaign::Drives;
 use sim_host::faults::rig::{Rig, PERIOD_US};
+use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::robot::plant::Plant;
+use sim_host::scene::{mjcf, Scene, Step};
 use teleop_core::scripted::PlanStep;
 
 /// The obstacle scene: a 6 cm step whose riser stands at x = 1.5 m.
@@ -59,13 +65,13 @@ fn drive_into_the_step(end_s: f64) -> Figures {
         PlanStep::at(0.0, TeleopMode::Fold),
         PlanStep::at(1.5, TeleopMode::WheelForward),
     ];
-    let mut rig = Rig::new(
-        Path::new(OBSTACLES),
-        plan,
-        &Faults::default(),
-        &Faults::default(),
-    )
-    .unwrap();
+    drive(Path::new(OBSTACLES), plan, Plant::default(), end_s)
+}
+
+/// Runs `plan` on `plant` in the scene `model` until `end_s`, from the first touch of the step.
+fn drive(model: &Path, plan: Vec<PlanStep>, plant: Plant, end_s: f64) -> Figures {
+    let faults = Faults::default();
+    let mut rig = Rig::with_plant(model, plan, &faults, &faults, plant).unwrap();
     let mut f = Figures::default();
     let end_us = (end_s * 1e6).round() as u64;
     while rig.stats().cycles * PERIOD_US < end_us {
@@ -99,18 +105,51 @@ fn drive_into_the_step(end_s: f64) -> Figures {
     f
 }
 
-#[test]
-fn driving_into_a_step_the_wheels_cannot_climb_stops_with_a_stall_fault() {
-    let f = drive_into_the_step(12.0);
-    println!("MEASURED W into the 6 cm step: {f:#?}");
+/// The acceptance: a stall fault within 0.5 s of the first touch of the step, the robot
+/// within 0.5 m of where it met the step ever after (no runaway), no fall, and `Fault` held.
+fn assert_stopped(f: &Figures) {
     let (_, contact_x) = f.contact.expect("never reached the step");
-    assert!(f.speed_at_contact_m_s > 0.4, "not at speed: {f:#?}");
     let (fault_s, flags) = f.fault_after_s.expect("no fault");
     assert!(fault_s <= 0.5, "{f:#?}");
     assert!(flags.contains(FaultFlags::WHEEL_STALL), "{f:#?}");
     assert!(!f.left_fault, "{f:#?}");
-    // No runaway: the robot stays within 0.5 m of where it met the step.
     let [low, high] = f.x_range_m;
     assert!(contact_x - low <= 0.5 && high - contact_x <= 0.5, "{f:#?}");
     assert!(!f.fell, "{f:#?}");
+}
+
+#[test]
+fn driving_into_a_step_the_wheels_cannot_climb_stops_with_a_stall_fault() {
+    let f = drive_into_the_step(12.0);
+    println!("MEASURED W into the 6 cm step: {f:#?}");
+    assert!(f.speed_at_contact_m_s > 0.4, "not at speed: {f:#?}");
+    assert_stopped(&f);
+}
+
+/// Seeded trials: the campaign's robot of each seed (drives rated) drives W, after its fold,
+/// into a 6 cm step 1.3–3.0 m ahead — reached accelerating, catching up with its reference
+/// (faster than it) or at speed. With the step at 1.0 m some robots' folds end against it.
+#[test]
+fn on_robots_as_built_and_at_any_distance_a_step_stops_the_wheels_with_a_stall_fault() {
+    const TRIALS: u64 = 12;
+    for seed in 0..TRIALS {
+        let riser_x_m = 1.3 + 1.7 * Draw::new(seed ^ 0x57a1_1000).unit();
+        let scene = Scene::Step(Step {
+            height_m: 0.06,
+            riser_x_m,
+            depth_m: 1.2,
+        });
+        let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+            .join("stall")
+            .join(seed.to_string());
+        let model = mjcf::write(&scene, Path::new(DEFAULT_MODEL), &dir).unwrap();
+        let plan = vec![
+            PlanStep::at(0.0, TeleopMode::Fold),
+            PlanStep::at(4.0, TeleopMode::WheelForward),
+        ];
+        let plant = Draws::of(seed).plant(Drives::Rated.ratings());
+        let f = drive(&model, plan, plant, 4.0 + riser_x_m / 0.3 + 3.0);
+        println!("MEASURED seed {seed}, step at {riser_x_m:.2} m: {f:?}");
+        assert_stopped(&f);
+    }
 }

@@ -43,6 +43,10 @@ pub struct RunawayConfig {
     /// … for this long before the deceleration began, ms: a robot still settling after a fold,
     /// or swinging in the limit cycle of a delayed loop, is not hitting anything.
     pub following_ms: u32,
+    /// A trip this soon after a deceleration against the commanded speed as hard as a
+    /// collision's is a stall, ms, even if the robot had not followed its reference (it was
+    /// still catching up with it) or now moves the other way (it was thrown back).
+    pub struck_ms: u32,
 }
 
 impl RunawayConfig {
@@ -58,6 +62,7 @@ impl RunawayConfig {
         collision_drop_m_s: 0.05,
         following_m_s: 0.15,
         following_ms: 200,
+        struck_ms: 600,
     };
 }
 
@@ -105,7 +110,10 @@ pub struct Runaway {
     following_ticks: u32,
     /// Whether the robot had followed its reference long enough when this deceleration began.
     collision_armed: bool,
-    limits_ticks: [u32; 4],
+    /// Ticks left in which a trip counts as a stall whatever the robot does: a hard
+    /// deceleration against the commanded speed (armed or not) was seen that recently.
+    struck_ticks: u32,
+    limits_ticks: [u32; 5],
     /// Last tick's speed error, m/s (NaN: none yet), and the filtered rate it changes, m/s².
     last_error_m_s: f32,
     error_rate_m_s2: f32,
@@ -122,11 +130,13 @@ impl Runaway {
             collision_ticks: 0,
             following_ticks: 0,
             collision_armed: false,
+            struck_ticks: 0,
             limits_ticks: [
                 ticks(config.speed_error_ms),
                 ticks(config.saturation_ms),
                 ticks(config.collision_ms),
                 ticks(config.following_ms),
+                ticks(config.struck_ms),
             ],
             last_error_m_s: f32::NAN,
             error_rate_m_s2: 0.0,
@@ -141,6 +151,7 @@ impl Runaway {
         self.collision_ticks = 0;
         self.following_ticks = 0;
         self.collision_armed = false;
+        self.struck_ticks = 0;
         self.last_error_m_s = f32::NAN;
         self.error_rate_m_s2 = 0.0;
     }
@@ -165,7 +176,13 @@ impl Runaway {
             && self.error_rate_m_s2 * direction < 0.0
             && error * direction <= -config.collision_drop_m_s;
         let collision = against && beyond(self.error_rate_m_s2.abs(), config.collision_m_s2);
-        let [speed_limit, saturation_limit, collision_limit, following_limit] = self.limits_ticks;
+        self.struck_ticks = if collision {
+            self.limits_ticks[4]
+        } else {
+            self.struck_ticks.saturating_sub(1)
+        };
+        let [speed_limit, saturation_limit, collision_limit, following_limit, _] =
+            self.limits_ticks;
         if !collision {
             self.collision_armed = self.following_ticks >= following_limit;
         }
@@ -178,7 +195,14 @@ impl Runaway {
         let tripped = self.speed_error_ticks >= speed_limit
             || self.saturated_ticks >= saturation_limit
             || self.collision_ticks >= collision_limit;
-        tripped.then(|| input.cause())
+        tripped.then(|| {
+            if self.struck_ticks > 0 {
+                // Thrown back by what it hit: blocked, whatever its speed says now.
+                FaultFlags::WHEEL_STALL
+            } else {
+                input.cause()
+            }
+        })
     }
 }
 
@@ -235,6 +259,25 @@ mod tests {
         assert_eq!(cause, FaultFlags::WHEEL_STALL);
         // The filter needs a few ticks to pass 2.5 m/s², then the collision time runs.
         assert!((ticks(24)..=ticks(24) + 4).contains(&tick), "{tick}");
+    }
+
+    #[test]
+    fn a_robot_thrown_back_by_what_it_hit_trips_as_a_stall_not_a_runaway() {
+        let mut runaway = detector();
+        // Catching up with its reference, 0.18 m/s faster than it: not following, so the
+        // collision rule is not armed.
+        for _ in 0..100 {
+            assert_eq!(runaway.update(&CONFIG, &input(0.66, 0.48, 10.0)), None);
+        }
+        // Stopped by a step within 0.1 s and thrown back at 0.6 m/s: the speed error trips.
+        let mut speed = 0.66;
+        let found = (1..=200).find_map(|tick| {
+            speed = f32::max(speed - 6.0 * 0.004, -0.6);
+            let cause = runaway.update(&CONFIG, &input(speed, 0.48, -30.0));
+            cause.map(|cause| (tick, cause))
+        });
+        let (_, cause) = found.expect("never tripped");
+        assert_eq!(cause, FaultFlags::WHEEL_STALL);
     }
 
     #[test]
