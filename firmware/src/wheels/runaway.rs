@@ -44,9 +44,13 @@ pub struct RunawayConfig {
     /// or swinging in the limit cycle of a delayed loop, is not hitting anything.
     pub following_ms: u32,
     /// A trip this soon after a deceleration against the commanded speed as hard as a
-    /// collision's is a stall, ms, even if the robot had not followed its reference (it was
-    /// still catching up with it) or now moves the other way (it was thrown back).
+    /// collision's is a stall, ms, even if the robot had not followed its reference closely
+    /// (it was still catching up with it) or now moves the other way (it was thrown back), …
     pub struck_ms: u32,
+    /// … if it had been within this of its reference for [`RunawayConfig::following_ms`] before,
+    /// m/s: a robot whose wheels slip in a limit cycle on low friction swings 0.5 m/s about its
+    /// reference, decelerating as hard at every swing, and is running away, not blocked.
+    pub struck_following_m_s: f32,
 }
 
 impl RunawayConfig {
@@ -63,6 +67,7 @@ impl RunawayConfig {
         following_m_s: 0.15,
         following_ms: 200,
         struck_ms: 600,
+        struck_following_m_s: 0.3,
     };
 }
 
@@ -111,8 +116,13 @@ pub struct Runaway {
     /// Whether the robot had followed its reference long enough when this deceleration began.
     collision_armed: bool,
     /// Ticks left in which a trip counts as a stall whatever the robot does: a hard
-    /// deceleration against the commanded speed (armed or not) was seen that recently.
+    /// deceleration against the commanded speed of a robot near its reference was seen that
+    /// recently.
     struck_ticks: u32,
+    /// Ticks the robot has been within [`RunawayConfig::struck_following_m_s`] of its
+    /// reference, and whether it had been long enough when this deceleration began.
+    near_ticks: u32,
+    struck_armed: bool,
     limits_ticks: [u32; 5],
     /// Last tick's speed error, m/s (NaN: none yet), and the filtered rate it changes, m/s².
     last_error_m_s: f32,
@@ -131,6 +141,8 @@ impl Runaway {
             following_ticks: 0,
             collision_armed: false,
             struck_ticks: 0,
+            near_ticks: 0,
+            struck_armed: false,
             limits_ticks: [
                 ticks(config.speed_error_ms),
                 ticks(config.saturation_ms),
@@ -152,6 +164,8 @@ impl Runaway {
         self.following_ticks = 0;
         self.collision_armed = false;
         self.struck_ticks = 0;
+        self.near_ticks = 0;
+        self.struck_armed = false;
         self.last_error_m_s = f32::NAN;
         self.error_rate_m_s2 = 0.0;
     }
@@ -176,7 +190,7 @@ impl Runaway {
             && self.error_rate_m_s2 * direction < 0.0
             && error * direction <= -config.collision_drop_m_s;
         let collision = against && beyond(self.error_rate_m_s2.abs(), config.collision_m_s2);
-        self.struck_ticks = if collision {
+        self.struck_ticks = if collision && self.struck_armed {
             self.limits_ticks[4]
         } else {
             self.struck_ticks.saturating_sub(1)
@@ -185,10 +199,13 @@ impl Runaway {
             self.limits_ticks;
         if !collision {
             self.collision_armed = self.following_ticks >= following_limit;
+            self.struck_armed = self.near_ticks >= following_limit;
         }
         let following = !beyond(error.abs(), config.following_m_s);
         let count = |ticks: u32, bad: bool| if bad { ticks.saturating_add(1) } else { 0 };
         self.following_ticks = count(self.following_ticks, following);
+        let near = !beyond(error.abs(), config.struck_following_m_s);
+        self.near_ticks = count(self.near_ticks, near);
         self.speed_error_ticks = count(self.speed_error_ticks, speed_bad);
         self.saturated_ticks = count(self.saturated_ticks, saturated);
         self.collision_ticks = count(self.collision_ticks, collision && self.collision_armed);
@@ -278,6 +295,21 @@ mod tests {
         });
         let (_, cause) = found.expect("never tripped");
         assert_eq!(cause, FaultFlags::WHEEL_STALL);
+    }
+
+    #[test]
+    fn wheels_slipping_in_a_limit_cycle_trip_as_a_runaway_not_a_stall() {
+        let mut runaway = detector();
+        // On low friction the law and the slipping wheels swing the robot ±0.5 m/s about its
+        // 0.2 m/s reference at 4 Hz, decelerating at every swing as hard as in a collision…
+        for tick in 0..250_u32 {
+            let phase = tick as f32 * 0.004 * 4.0 * core::f32::consts::TAU;
+            let speed = 0.2 + 0.5 * phase.sin();
+            assert_eq!(runaway.update(&CONFIG, &input(speed, 0.2, 20.0)), None);
+        }
+        // … then runs away at 1.1 m/s.
+        let found = ticks_to_trip(&mut runaway, &input(1.1, 0.2, 20.0));
+        assert_eq!(found.map(|(_, cause)| cause), Some(FaultFlags::RUNAWAY));
     }
 
     #[test]
