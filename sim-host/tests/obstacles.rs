@@ -14,7 +14,6 @@ use sim_host::campaign::draw::{Draw, Draws};
 use sim_host::campaign::Drives;
 use sim_host::faults::rig::{Rig, PERIOD_US};
 use sim_host::robot::model::DEFAULT_MODEL;
-use sim_host::robot::physics::Physics;
 use sim_host::scene::{mjcf, Scene, Step};
 use teleop_core::scripted::PlanStep;
 
@@ -30,19 +29,6 @@ fn scene_file(scene: &Scene, name: &str) -> PathBuf {
         .join("obstacles")
         .join(name);
     mjcf::write(scene, Path::new(DEFAULT_MODEL), &dir).unwrap()
-}
-
-/// Whether any part of the robot touches the geom `name`.
-fn touches(physics: &Physics, name: &str) -> bool {
-    let id = physics
-        .model()
-        .name_to_id(mujoco_rs::wrappers::mj_model::MjtObjBase::mjOBJ_GEOM, name)
-        .and_then(|id| i32::try_from(id).ok());
-    physics
-        .data()
-        .contact()
-        .iter()
-        .any(|c| Some(c.geom1) == id || Some(c.geom2) == id)
 }
 
 /// What a trot toward a step did.
@@ -93,7 +79,7 @@ fn trot_into_step(seed: u64, height_m: f64, approach_m: f64) -> Figures {
         let record = rig.records().last().unwrap().clone();
         f.max_tilt_deg = f.max_tilt_deg.max(record.tilt_deg);
         f.fell |= record.fallen();
-        if f.contact_s.is_none() && touches(rig.sim().physics(), "step") {
+        if f.contact_s.is_none() && rig.sim().physics().touches_geom("step") {
             f.contact_s = Some(t);
         }
         let reported = record.faults.contains(FaultFlags::LEG_BLOCKED);

@@ -22,23 +22,6 @@ use teleop_core::scripted::PlanStep;
 /// The obstacle scene: a 6 cm step whose riser stands at x = 1.5 m.
 const OBSTACLES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/models/obstacles.xml");
 
-/// Whether any part of the robot touches the step.
-fn touches_step(rig: &Rig) -> bool {
-    let physics = rig.sim().physics();
-    let step = physics
-        .model()
-        .name_to_id(
-            mujoco_rs::wrappers::mj_model::MjtObjBase::mjOBJ_GEOM,
-            "step",
-        )
-        .and_then(|id| i32::try_from(id).ok());
-    physics
-        .data()
-        .contact()
-        .iter()
-        .any(|c| Some(c.geom1) == step || Some(c.geom2) == step)
-}
-
 /// What driving into the step did, from the first contact with it.
 #[derive(Debug, Default)]
 struct Figures {
@@ -82,7 +65,7 @@ fn drive(model: &Path, plan: Vec<PlanStep>, plant: Plant, end_s: f64) -> Figures
         let x = torso.pos_m[0];
         let speed = torso.vel_m_s[0].hypot(torso.vel_m_s[1]);
         let Some((contact_s, _)) = f.contact else {
-            if touches_step(&rig) {
+            if rig.sim().physics().touches_geom("step") {
                 f.contact = Some((t, x));
                 f.speed_at_contact_m_s = speed;
                 f.x_range_m = [x, x];

@@ -271,6 +271,23 @@ impl Physics {
         }
     }
 
+    /// Whether anything touches the geom named `name` (an obstacle of a scene: `step`,
+    /// `ramp_up`, …); `false` if the model has no such geom.
+    pub fn touches_geom(&self, name: &str) -> bool {
+        let Some(id) = self
+            .data
+            .model()
+            .name_to_id(MjtObj::mjOBJ_GEOM, name)
+            .and_then(|id| i32::try_from(id).ok())
+        else {
+            return false;
+        };
+        self.data
+            .contact()
+            .iter()
+            .any(|c| c.geom1 == id || c.geom2 == id)
+    }
+
     /// Names of the robot's geoms touching anything that is not the robot (diagnostics).
     pub fn ground_contact_names(&self) -> Vec<String> {
         let model = self.data.model();
