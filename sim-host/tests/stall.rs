@@ -128,7 +128,7 @@ fn drive_w_into_step(name: &str, plant: Plant, riser_x_m: f64) -> Figures {
 }
 
 /// The robot as drawn at the distances where it reached the step still catching up with its
-/// reference (0.8 and 1.0 m: 0.62 m/s against 0.48) or at speed (2.5 m/s), which a thrown-back
+/// reference (0.8 and 1.0 m: 0.62 m/s against 0.48) or at speed (2.5 m), which a thrown-back
 /// robot once turned into a runaway 0.8–1.1 m long; then seeded trials: the campaign's robot of
 /// each seed (drives rated) with the step 1.3–3.0 m ahead (at 1.0 m some robots' folds end
 /// against it).

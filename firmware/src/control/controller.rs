@@ -331,7 +331,8 @@ impl Controller {
     }
 
     fn apply(&mut self, event: Event) {
-        if matches!(event, Event::Request(_)) {
+        if matches!(event, Event::Request(_)) && !matches!(self.state, State::EStop | State::Fault)
+        {
             // The operator has seen the stop and asks for something: the report has served.
             self.blocked.1 = false;
         }
@@ -341,9 +342,12 @@ impl Controller {
         }
         let entering_trot = matches!(next, State::Legs(LegMotion::Trot(_)))
             && !matches!(self.state, State::Legs(LegMotion::Trot(_)));
+        if matches!(next, State::Legs(LegMotion::Trot(_))) {
+            // Counted afresh for every trot and every change of its direction.
+            self.blocked.0.reset();
+        }
         if entering_trot {
             self.trot.restart();
-            self.blocked.0.reset();
         }
         if next == State::Wheels(WheelMotion::Rotate) && self.state != next {
             // A turn on the spot turns where the robot is: a position error still remembered

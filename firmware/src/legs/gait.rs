@@ -164,11 +164,12 @@ impl Trot {
 
     /// How far `leg`'s foot is through its swing now, walking in `direction` (0 at lift-off,
     /// toward 1 at touchdown), or `None` while it stands: the swing is the cycle past the
-    /// stance share ([`FootTrajectory::duty`]; the report's sinusoids lift for half of it).
+    /// stance share ([`FootTrajectory::duty`]). The report's sinusoids have no swing of that
+    /// shape (their hips sweep forward across the cycle's turn): `None` throughout.
     pub fn swing_share(&self, leg: Leg, direction: Direction) -> Option<f32> {
         let duty = match self.params.generator {
             Generator::Cartesian(path) => crate::math::clamp(path.duty, 0.5, 0.9),
-            Generator::Sine(_) => 0.5,
+            Generator::Sine(_) => return None,
         };
         let fraction = self.leg_phase(leg, direction).fraction();
         (fraction >= duty).then(|| (fraction - duty) / (1.0 - duty))

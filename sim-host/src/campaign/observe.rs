@@ -179,12 +179,16 @@ impl Watch {
             self.fell_at_s = Some(t);
         }
         let estop_sent = self.stop.is_some();
-        // A degraded link is the controller's one refusal outside `Fault`: it stops once and
-        // refuses new motion while it reports the flag.
+        // A degraded link and a blocked trot are the controller's stops outside `Fault`: it
+        // stops once and reports the flag (on flat ground a blocked trot is a false stop, and
+        // its verdict says so with the cause).
         let stopped = match record.state {
             Some(State::Fault) => true,
             Some(State::EStop) => !estop_sent,
-            _ => record.faults.contains(FaultFlags::LINK_DEGRADED),
+            _ => {
+                record.faults.contains(FaultFlags::LINK_DEGRADED)
+                    || record.faults.contains(FaultFlags::LEG_BLOCKED)
+            }
         };
         let cause = record.faults.without(FaultFlags::AWAITING_STOP);
         if stopped && self.abort.is_none() && !cause.is_empty() {

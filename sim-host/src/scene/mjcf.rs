@@ -13,8 +13,11 @@ const PLATE_HALF_M: f64 = 0.02;
 /// The file name of a written scene.
 pub const FILE_NAME: &str = "scene.xml";
 
-/// The MJCF text of `scene` around the robot model at `robot_model` (an absolute path).
-pub fn text(scene: &Scene, robot_model: &Path) -> String {
+/// The MJCF text of `scene` around the robot model at `robot_model` (an absolute path, as
+/// text: MJCF names files by text). MuJoCo resolves the robot's own file references (meshes,
+/// textures) against the folder of this file, so a robot model with files of its own must
+/// name them by absolute paths; the shipped model has none.
+pub fn text(scene: &Scene, robot_model: &str) -> String {
     let mut xml = String::new();
     let _ = writeln!(
         xml,
@@ -22,11 +25,7 @@ pub fn text(scene: &Scene, robot_model: &Path) -> String {
         scene.kind()
     );
     let _ = writeln!(xml, "<mujoco model=\"hybrid_robot_{}\">", scene.kind());
-    let _ = writeln!(
-        xml,
-        "  <include file=\"{}\"/>",
-        escape(&robot_model.to_string_lossy())
-    );
+    let _ = writeln!(xml, "  <include file=\"{}\"/>", escape(robot_model));
     let _ = writeln!(xml, "  <worldbody>");
     for feature in scene.features() {
         let _ = writeln!(xml, "    {}", geom(&feature));
@@ -39,17 +38,21 @@ pub fn text(scene: &Scene, robot_model: &Path) -> String {
 /// Writes `scene` around `robot_model` into `dir` (created if missing) as [`FILE_NAME`]; the
 /// path of the file.
 pub fn write(scene: &Scene, robot_model: &Path, dir: &Path) -> Result<PathBuf, SceneError> {
-    let robot = std::path::absolute(robot_model).map_err(|source| SceneError::Write {
+    let robot_path = |reason: String| SceneError::RobotPath {
         path: robot_model.to_owned(),
-        source,
-    })?;
+        reason,
+    };
+    let absolute = std::path::absolute(robot_model).map_err(|e| robot_path(e.to_string()))?;
+    let robot = absolute
+        .to_str()
+        .ok_or_else(|| robot_path("not UTF-8: MJCF names it as text; rename or move it".into()))?;
     let io = |path: &Path| {
         let path = path.to_owned();
         move |source| SceneError::Write { path, source }
     };
     std::fs::create_dir_all(dir).map_err(io(dir))?;
     let path = dir.join(FILE_NAME);
-    std::fs::write(&path, text(scene, &robot)).map_err(io(&path))?;
+    std::fs::write(&path, text(scene, robot)).map_err(io(&path))?;
     Ok(path)
 }
 
@@ -108,13 +111,13 @@ mod tests {
 
     #[test]
     fn a_step_is_a_block_on_the_floor_and_a_ramp_a_plate_along_its_slope() {
-        let step = text(&Scene::Step(Step::DEFAULT), Path::new("/robot & co/r.xml"));
+        let step = text(&Scene::Step(Step::DEFAULT), "/robot & co/r.xml");
         assert!(step.contains("file=\"/robot &amp; co/r.xml\""), "{step}");
         assert!(
             step.contains("pos=\"1.600000 0.000000 0.030000\" size=\"0.600000 1.500000 0.030000\""),
             "{step}"
         );
-        let ramp = text(&Scene::Ramp(Ramp::DEFAULT), Path::new("/r.xml"));
+        let ramp = text(&Scene::Ramp(Ramp::DEFAULT), "/r.xml");
         assert_eq!(ramp.matches("<geom ").count(), 3, "{ramp}");
         // 10° up: the quaternion turns −5° about y.
         let half = 5f64.to_radians();

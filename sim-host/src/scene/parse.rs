@@ -20,6 +20,12 @@ pub enum SceneError {
         /// The name given.
         kind: String,
     },
+    /// A `[scene]` table without `kind`.
+    #[error("{at}: [scene] needs kind = \"flat\", \"step\", \"flight\", \"ramp\" or \"course\"")]
+    MissingKind {
+        /// Where the table is.
+        at: String,
+    },
     /// A key the scene does not have.
     #[error("{at}: the scene `{kind}` has no `{key}`: its keys are {known}")]
     UnknownKey {
@@ -32,25 +38,61 @@ pub enum SceneError {
         /// The keys it has.
         known: &'static str,
     },
-    /// A value that is not a number, or outside its range.
-    #[error("{at}: {key} = {value}: {allowed}")]
-    Value {
+    /// A key given twice.
+    #[error("{at}: `{key}` is given twice: give each key once")]
+    DuplicateKey {
+        /// Where it was given the second time.
+        at: String,
+        /// The key.
+        key: String,
+    },
+    /// A value that is not a number (or, for `count`, not a whole one).
+    #[error("{at}: {key} = {value}: {expected}")]
+    NotANumber {
         /// Where it was given.
         at: String,
         /// The key.
         key: String,
         /// The value as given.
         value: String,
-        /// What is allowed.
-        allowed: String,
+        /// What to give.
+        expected: &'static str,
     },
-    /// Text that is not `KIND` or `KIND:KEY=VALUE,…`, or a `[scene]` table without `kind`.
-    #[error("{at}: {message}")]
-    Syntax {
+    /// A number outside the key's range.
+    #[error("{at}: {key} = {value}: give a number from {low} to {high}")]
+    OutOfRange {
         /// Where it was given.
         at: String,
-        /// What is wrong and how to write it.
+        /// The key.
+        key: String,
+        /// The value given.
+        value: f64,
+        /// The range.
+        low: f64,
+        /// The range.
+        high: f64,
+    },
+    /// `--scene` text that is not `KIND` or `KIND:KEY=VALUE,…`.
+    #[error("--scene: `{pair}`: write KEY=VALUE, e.g. step:height_m=0.08")]
+    NotAPair {
+        /// The part that is not `KEY=VALUE`.
+        pair: String,
+    },
+    /// A scenario file that is not valid TOML.
+    #[error("{at}: {message}")]
+    Toml {
+        /// The file and line.
+        at: String,
+        /// The TOML parser's message.
         message: String,
+    },
+    /// The robot's model path cannot be made absolute, or is not UTF-8 (MJCF names it as text).
+    #[error("the robot model path {}: {reason}", path.display())]
+    RobotPath {
+        /// The path.
+        path: PathBuf,
+        /// Why it cannot be named in the scene.
+        reason: String,
     },
     /// The scene's MJCF could not be written.
     #[error("cannot write the scene to {}: {source}", path.display())]
@@ -62,9 +104,9 @@ pub enum SceneError {
     },
 }
 
-/// One key's value and where it was given.
+/// One key's value and where it was given: a number, or text that should have been one.
 struct Given {
-    value: String,
+    value: Result<f64, String>,
     at: String,
 }
 
@@ -76,13 +118,11 @@ impl Scene {
         let mut given = BTreeMap::new();
         for pair in rest.split(',').map(str::trim).filter(|p| !p.is_empty()) {
             let Some((key, value)) = pair.split_once('=') else {
-                return Err(SceneError::Syntax {
-                    at: at(),
-                    message: format!("`{pair}`: write KEY=VALUE, e.g. step:height_m=0.08"),
-                });
+                return Err(SceneError::NotAPair { pair: pair.into() });
             };
-            let value = value.trim().to_owned();
-            given.insert(key.trim().to_owned(), Given { value, at: at() });
+            let value = value.trim();
+            let value = value.parse::<f64>().map_err(|_| value.to_owned());
+            insert(&mut given, key.trim(), Given { value, at: at() })?;
         }
         build(kind.trim(), &at(), given)
     }
@@ -92,35 +132,50 @@ impl Scene {
     pub fn from_scenario(path: &Path, text: &str) -> Result<Option<Self>, SceneError> {
         #[derive(serde::Deserialize)]
         struct File {
-            scene: Option<BTreeMap<String, toml::Spanned<toml::Value>>>,
+            scene: Option<toml::Spanned<BTreeMap<String, toml::Spanned<toml::Value>>>>,
         }
         let at = |offset: usize| format!("{}:{}", path.display(), line_of(text, offset));
-        let file: File = toml::from_str(text).map_err(|e| SceneError::Syntax {
+        let file: File = toml::from_str(text).map_err(|e| SceneError::Toml {
             at: at(e.span().map_or(0, |s| s.start)),
             message: e.message().trim().to_owned(),
         })?;
         let Some(table) = file.scene else {
             return Ok(None);
         };
+        let table_at = at(table.span().start);
         let mut given = BTreeMap::new();
-        for (key, value) in table {
-            let shown = match value.get_ref() {
-                toml::Value::String(s) => s.clone(),
-                other => other.to_string(),
-            };
+        let mut kind = None;
+        for (key, value) in table.into_inner() {
             let at = at(value.span().start);
-            given.insert(key, Given { value: shown, at });
+            match (key.as_str(), value.into_inner()) {
+                ("kind", toml::Value::String(name)) => kind = Some((name, at)),
+                ("kind", other) => kind = Some((other.to_string(), at)),
+                (_, toml::Value::Float(v)) => insert(&mut given, &key, Given { value: Ok(v), at })?,
+                (_, toml::Value::Integer(v)) => {
+                    let value = Ok(v as f64);
+                    insert(&mut given, &key, Given { value, at })?;
+                }
+                (_, other) => {
+                    let value = Err(other.to_string());
+                    insert(&mut given, &key, Given { value, at })?;
+                }
+            }
         }
-        let Some(kind) = given.remove("kind") else {
-            return Err(SceneError::Syntax {
-                at: format!("{}", path.display()),
-                message:
-                    "[scene] needs kind = \"flat\", \"step\", \"flight\", \"ramp\" or \"course\""
-                        .into(),
-            });
-        };
-        build(&kind.value, &kind.at, given).map(Some)
+        let (kind, kind_at) = kind.ok_or(SceneError::MissingKind { at: table_at })?;
+        build(&kind, &kind_at, given).map(Some)
     }
+}
+
+/// Adds `key`'s value; a key given twice is refused.
+fn insert(given: &mut BTreeMap<String, Given>, key: &str, value: Given) -> Result<(), SceneError> {
+    if given.contains_key(key) {
+        return Err(SceneError::DuplicateKey {
+            at: value.at,
+            key: key.into(),
+        });
+    }
+    given.insert(key.into(), value);
+    Ok(())
 }
 
 /// The 1-based line of byte `offset` in `text`.
@@ -145,21 +200,30 @@ impl Keys {
         let Some(g) = self.0.remove(key) else {
             return Ok(default);
         };
-        match g.value.parse::<f64>() {
-            Ok(v) if v.is_finite() && (low..=high).contains(&v) && !(whole && v.fract() != 0.0) => {
-                Ok(v)
-            }
-            _ => Err(SceneError::Value {
+        let not_a_number = |value: String| SceneError::NotANumber {
+            at: g.at.clone(),
+            key: key.to_owned(),
+            value,
+            expected: if whole {
+                "give a whole number"
+            } else {
+                "give a number"
+            },
+        };
+        let value = g.value.map_err(not_a_number)?;
+        if !value.is_finite() || (whole && value.fract() != 0.0) {
+            return Err(not_a_number(value.to_string()));
+        }
+        if !(low..=high).contains(&value) {
+            return Err(SceneError::OutOfRange {
                 at: g.at,
                 key: key.to_owned(),
-                value: g.value,
-                allowed: if whole {
-                    format!("give a whole number from {low} to {high}")
-                } else {
-                    format!("give a number from {low} to {high}")
-                },
-            }),
+                value,
+                low,
+                high,
+            });
         }
+        Ok(value)
     }
 
     /// `key`'s number as [`Keys::take`], not whole.
@@ -266,10 +330,14 @@ mod tests {
             ),
             ("ramp:angle_deg=steep", "angle_deg = steep"),
             ("flight:count", "write KEY=VALUE"),
+            ("flight:count=2.5", "count = 2.5: give a whole number"),
+            ("flight:count=9", "count = 9: give a number from 1 to 5"),
             (
-                "flight:count=2.5",
-                "count = 2.5: give a whole number from 1 to 5",
+                "step:height_m=0.08,height_m=0.1",
+                "`height_m` is given twice",
             ),
+            ("step:height_m=nan", "height_m = NaN: give a number"),
+            ("step:depth_m=inf", "depth_m = inf: give a number"),
         ];
         for (arg, needle) in cases {
             let err = Scene::from_arg(arg).unwrap_err().to_string();
@@ -283,6 +351,16 @@ mod tests {
         );
         let file = "duration_s = 5\n[scene]\nheight_m = 0.1\n";
         let err = Scene::from_scenario(Path::new("s.toml"), file).unwrap_err();
-        assert!(err.to_string().contains("needs kind"), "{err}");
+        assert!(
+            err.to_string().starts_with("s.toml:2: [scene] needs kind"),
+            "{err}"
+        );
+        let file = "duration_s = 5\n[scene]\nkind = \"step\"\nheight_m = \"0.08\"\n";
+        let err = Scene::from_scenario(Path::new("s.toml"), file).unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("s.toml:4: height_m = \"0.08\": give a number"),
+            "{err}"
+        );
     }
 }

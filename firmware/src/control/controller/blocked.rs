@@ -23,6 +23,13 @@ impl Controller {
         }
         let (leading, sign) = ([Leg::Fl, Leg::Fr], 1.0);
         let config = self.config.blocked;
+        // The stride, and with it how far a stopped foot falls behind, shrinks with the speed
+        // scale; the lag is judged as at full stride. Below the configured scale a riser cannot
+        // be told from flat ground's lags, and the trot is not watched.
+        let scale = self.teleop.speed_scale;
+        if scale.is_nan() || scale < config.min_scale {
+            return;
+        }
         let mut next = self.trot;
         next.advance();
         for leg in leading {
@@ -33,7 +40,7 @@ impl Controller {
             }
             let target = LegJoints::from_array(*self.legs_rad.leg(leg));
             let measured = LegJoints::from_array(*self.sensors.joint_position_rad.leg(leg));
-            let lag = lag_m(&self.config.geometry, &target, &measured, sign);
+            let lag = lag_m(&self.config.geometry, &target, &measured, sign) / scale;
             if self.blocked.0.swing_measured(&config, leg, lag) {
                 self.blocked.1 = true;
                 self.apply(Event::LegBlocked);

@@ -14,7 +14,7 @@ use sim_host::robot::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
 use sim_host::robot::plant::{DriveRatings, Plant};
 use sim_host::robot::sensing::DriveSensing;
 use sim_host::robot::variation::Variation;
-use sim_host::scene::Scene;
+use sim_host::scene::{Scene, SceneError};
 use sim_host::session::{self, BusChoice, Clock, FrameSettings, SegmentSpec, SessionConfig};
 use teleop_core::scenario::{mode_name, Scenario};
 use teleop_core::scripted::PlanStep;
@@ -82,9 +82,15 @@ fn parse_scene(text: &str) -> Result<SceneArg, String> {
     if text.trim() == "obstacles" {
         return Ok(SceneArg::Obstacles);
     }
+    if text.trim().starts_with("obstacles:") {
+        return Err("`obstacles` is a fixed file and takes no keys: use `step`, `ramp` or `course` with keys".into());
+    }
     Scene::from_arg(text)
         .map(SceneArg::Made)
-        .map_err(|e| e.to_string())
+        .map_err(|e| match e {
+            SceneError::UnknownKind { .. } => format!("{e}, or obstacles (the shipped file)"),
+            other => other.to_string(),
+        })
 }
 
 #[derive(Debug, clap::Args)]
@@ -282,13 +288,14 @@ fn model_path(args: &RunArgs) -> Result<PathBuf, String> {
         .model
         .clone()
         .unwrap_or_else(|| PathBuf::from(DEFAULT_MODEL));
+    // A scenario's scene is checked even when --scene replaces it: a bad file is an error.
     let from_scenario = match &args.scenario {
-        Some(path) if args.scene.is_none() => {
+        Some(path) => {
             let text = std::fs::read_to_string(path)
                 .map_err(|e| format!("cannot read the scenario {}: {e}", path.display()))?;
             Scene::from_scenario(path, &text).map_err(|e| e.to_string())?
         }
-        _ => None,
+        None => None,
     };
     match args.scene.or(from_scenario.map(SceneArg::Made)) {
         None | Some(SceneArg::Made(Scene::Flat)) => Ok(robot),
