@@ -51,10 +51,6 @@ pub struct RunawayConfig {
     /// m/s: a robot whose wheels slip in a limit cycle on low friction swings 0.5 m/s about its
     /// reference, decelerating as hard at every swing, and is running away, not blocked.
     pub struck_following_m_s: f32,
-    /// … and only while the robot moves slower than this, m/s, either way: faster, it is
-    /// running away whatever it hit, and the runaway's brake, not the stall's held wheels,
-    /// stops it.
-    pub struck_max_m_s: f32,
 }
 
 impl RunawayConfig {
@@ -72,7 +68,6 @@ impl RunawayConfig {
         following_ms: 200,
         struck_ms: 600,
         struck_following_m_s: 0.3,
-        struck_max_m_s: 0.8,
     };
 }
 
@@ -217,9 +212,11 @@ impl Runaway {
         let tripped = self.speed_error_ticks >= speed_limit
             || self.saturated_ticks >= saturation_limit
             || self.collision_ticks >= collision_limit;
-        let slow = !beyond(input.ground_speed_m_s.abs(), config.struck_max_m_s);
+        // The robot's speed does not decide it: thrown back from a step at 0.62 m/s, the
+        // measured ground speed swung to 1.03 m/s and more (it adds the body's pitch rate,
+        // which swings as the robot is thrown).
         tripped.then(|| {
-            if self.struck_ticks > 0 && slow {
+            if self.struck_ticks > 0 {
                 // Thrown back by what it hit: blocked, whatever its speed says now.
                 FaultFlags::WHEEL_STALL
             } else {
@@ -301,21 +298,6 @@ mod tests {
         });
         let (_, cause) = found.expect("never tripped");
         assert_eq!(cause, FaultFlags::WHEEL_STALL);
-    }
-
-    #[test]
-    fn a_robot_running_away_fast_after_a_collision_trips_as_a_runaway() {
-        let mut runaway = detector();
-        for _ in 0..100 {
-            assert_eq!(runaway.update(&CONFIG, &input(0.48, 0.48, 10.0)), None);
-        }
-        // Stopped hard (a collision opens the window), then run away backward at 1.5 m/s by a
-        // saturated law before the collision rule's own time is up.
-        for speed in [0.4, 0.2, 0.0] {
-            assert_eq!(runaway.update(&CONFIG, &input(speed, 0.48, -60.0)), None);
-        }
-        let found = ticks_to_trip(&mut runaway, &input(-1.5, 0.48, -60.0));
-        assert_eq!(found.map(|(_, cause)| cause), Some(FaultFlags::RUNAWAY));
     }
 
     #[test]
