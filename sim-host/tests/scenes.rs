@@ -2,12 +2,16 @@
 //! robot in it, and MuJoCo's own ground, probed by casting rays down onto it, is where the
 //! scene's profile says (what tests and summaries judge crossings by).
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use mujoco_rs::prelude::{MjData, MjModel};
 use sim_host::robot::model::DEFAULT_MODEL;
 use sim_host::robot::physics::Physics;
+use sim_host::robot::plant::Plant;
 use sim_host::scene::{mjcf, Scene};
+use sim_host::session;
 
 fn written(scene: &Scene, name: &str) -> PathBuf {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
@@ -66,4 +70,37 @@ fn a_scenario_names_its_scene_and_sim_host_builds_it() {
     let scene = Scene::from_scenario(path, file).unwrap().unwrap();
     assert_eq!(scene.kind(), "flight");
     assert_eq!(scene.ground_height_m(2.0), 0.12);
+}
+
+#[test]
+fn the_summary_names_the_parts_of_the_robot_that_touched_an_obstacle() {
+    let scene = Scene::from_arg("step:height_m=0.10,riser_x_m=0.6").unwrap();
+    let (plan, segments) = common::plan(&[(0.0, "stand"), (1.0, "L")]);
+    let mut config = common::config(Plant::default(), plan, segments, 9.0);
+    config.model = written(&scene, "summary");
+    let report = session::run(&config).unwrap();
+    let [stand, trot] = &report.segments[..] else {
+        panic!("{:?}", report.segments.len())
+    };
+    println!(
+        "MEASURED contacts with the step while trotting: {:?}",
+        trot.obstacle_contacts
+    );
+    assert!(
+        stand.obstacle_contacts.is_empty(),
+        "{:?}",
+        stand.obstacle_contacts
+    );
+    // The front feet meet the riser; the floor is not an obstacle.
+    let parts: Vec<&str> = trot
+        .obstacle_contacts
+        .iter()
+        .map(|c| c.part.as_str())
+        .collect();
+    assert!(parts.iter().any(|p| p.starts_with("foot_f")), "{parts:?}");
+    assert!(trot
+        .obstacle_contacts
+        .iter()
+        .all(|c| c.obstacle == "step" && c.cycles > 0));
+    assert!(!parts.iter().any(|p| p.starts_with("foot_b")), "{parts:?}");
 }

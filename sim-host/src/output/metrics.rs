@@ -117,6 +117,21 @@ pub struct SegmentSummary {
     pub moved_after_1s_m: f64,
     /// Bus traffic in the segment.
     pub bus: BusCounters,
+    /// Which parts of the robot touched which obstacle of the scene (not the floor), and for
+    /// how many cycles, in the order first seen: a step's riser met by the feet, the shanks,
+    /// the wheels or the torso.
+    pub obstacle_contacts: Vec<ObstacleContact>,
+}
+
+/// A part of the robot touching an obstacle in a segment.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize)]
+pub struct ObstacleContact {
+    /// The obstacle's geom (`step`, `ramp_up`, `flight_up_1`, …).
+    pub obstacle: String,
+    /// The robot's geom (`foot_fl`, `shank_fr`, `wheel_left`, `torso`, …).
+    pub part: String,
+    /// Cycles in which they touched.
+    pub cycles: u64,
 }
 
 /// Accumulates a segment's figures cycle by cycle.
@@ -133,6 +148,9 @@ pub struct SegmentTracker {
     /// (time s, x m, y m, unwrapped yaw deg) of every cycle (of fewer in a segment longer
     /// than 4.4 simulated minutes: bounded memory).
     track: Decimated<(f64, f64, f64, f64)>,
+    /// The geom ids of each entry of `summary.obstacle_contacts`, and the cycle it was last
+    /// counted in (a pair touches at several points).
+    contact_ids: Vec<((usize, usize), u64)>,
 }
 
 impl SegmentTracker {
@@ -175,6 +193,7 @@ impl SegmentTracker {
                 settled_after_s: None,
                 moved_after_1s_m: 0.0,
                 bus: BusCounters::default(),
+                obstacle_contacts: Vec::new(),
             },
             start_pos: torso.pos_m,
             start_yaw: yaw,
@@ -184,6 +203,7 @@ impl SegmentTracker {
             wheel_limit_nm: f64::from(config.wheel_torque_limit_nm),
             torques: TorqueTracker::start(sim),
             track: Decimated::default(),
+            contact_ids: Vec::new(),
         }
     }
 
@@ -250,6 +270,36 @@ impl SegmentTracker {
         self.track
             .push((sim.time_s(), torso.pos_m[0], torso.pos_m[1], s.dyaw_deg));
         s.bus = bus.since(&self.start_bus);
+        self.count_obstacle_contacts(sim);
+    }
+
+    /// Counts this cycle's contacts with obstacles, each pair once.
+    fn count_obstacle_contacts(&mut self, sim: &Simulator) {
+        let physics = sim.physics();
+        let cycle = self.summary.cycles;
+        for pair in physics.obstacle_contacts() {
+            let index = match self.contact_ids.iter().position(|(ids, _)| *ids == pair) {
+                Some(index) => index,
+                None => {
+                    self.contact_ids.push((pair, 0));
+                    self.summary.obstacle_contacts.push(ObstacleContact {
+                        obstacle: physics.geom_name(pair.0).to_owned(),
+                        part: physics.geom_name(pair.1).to_owned(),
+                        cycles: 0,
+                    });
+                    self.contact_ids.len() - 1
+                }
+            };
+            if let (Some((_, last)), Some(entry)) = (
+                self.contact_ids.get_mut(index),
+                self.summary.obstacle_contacts.get_mut(index),
+            ) {
+                if *last != cycle {
+                    *last = cycle;
+                    entry.cycles += 1;
+                }
+            }
+        }
     }
 
     /// The segment's figures.

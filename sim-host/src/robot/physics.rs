@@ -5,6 +5,7 @@
 use std::path::Path;
 
 use mujoco_rs::prelude::{MjData, MjModel};
+use mujoco_rs::wrappers::mj_model::MjtGeomBase as MjtGeom;
 use mujoco_rs::wrappers::mj_model::MjtObjBase as MjtObj;
 use protocol::{Joints, Leg};
 
@@ -286,6 +287,37 @@ impl Physics {
             .contact()
             .iter()
             .any(|c| c.geom1 == id || c.geom2 == id)
+    }
+
+    /// This step's contacts of a part of the robot with an obstacle (a geom of the world that
+    /// is not a plane: a scene's steps and ramps, not the floor), as (obstacle geom, robot
+    /// geom) ids; a pair may come more than once (several contact points).
+    pub fn obstacle_contacts(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        let model = self.data.model();
+        let (body_of, type_of) = (model.geom_bodyid(), model.geom_type());
+        let world = move |id: usize| body_of.get(id) == Some(&0);
+        let obstacle = move |id: usize| {
+            world(id) && type_of.get(id).is_some_and(|t| *t != MjtGeom::mjGEOM_PLANE)
+        };
+        self.data.contact().iter().filter_map(move |c| {
+            let (a, b) = (
+                usize::try_from(c.geom1).ok()?,
+                usize::try_from(c.geom2).ok()?,
+            );
+            match (obstacle(a), obstacle(b)) {
+                (true, false) if !world(b) => Some((a, b)),
+                (false, true) if !world(a) => Some((b, a)),
+                _ => None,
+            }
+        })
+    }
+
+    /// The name of geom `id` (`(unnamed)` without one).
+    pub fn geom_name(&self, id: usize) -> &str {
+        self.data
+            .model()
+            .id_to_name(MjtObj::mjOBJ_GEOM, id)
+            .unwrap_or("(unnamed)")
     }
 
     /// Names of the robot's geoms touching anything that is not the robot (diagnostics).
