@@ -113,9 +113,10 @@ pub struct Controller {
     /// Ground speed of the wheels last tick, m/s (`None` off the wheels): its change is the
     /// acceleration the attitude estimator takes out of the accelerometer's reading.
     last_ground_m_s: Option<f32>,
-    /// The trot's blocked swings, and whether a blocked trot stopped the robot (reported
-    /// until the operator's next request; see [`crate::legs::blocked`]).
-    blocked: (BlockedSwings, bool),
+    /// The trot's blocked swings (see [`crate::legs::blocked`]).
+    blocked_swings: BlockedSwings,
+    /// Whether a blocked trot stopped the robot: reported until the operator's next request.
+    leg_blocked: bool,
 }
 
 impl Controller {
@@ -160,7 +161,8 @@ impl Controller {
             fold_done_at: None,
             stopped_on_wheels: false,
             last_ground_m_s: None,
-            blocked: (BlockedSwings::new(), false),
+            blocked_swings: BlockedSwings::new(),
+            leg_blocked: false,
         })
     }
 
@@ -334,7 +336,7 @@ impl Controller {
         if matches!(event, Event::Request(_)) && !matches!(self.state, State::EStop | State::Fault)
         {
             // The operator has seen the stop and asks for something: the report has served.
-            self.blocked.1 = false;
+            self.leg_blocked = false;
         }
         let next = self.state.next(event);
         if next == self.state {
@@ -344,7 +346,7 @@ impl Controller {
             && !matches!(self.state, State::Legs(LegMotion::Trot(_)));
         if matches!(next, State::Legs(LegMotion::Trot(_))) {
             // Counted afresh for every trot and every change of its direction.
-            self.blocked.0.reset();
+            self.blocked_swings.reset();
         }
         if entering_trot {
             self.trot.restart();

@@ -71,7 +71,7 @@ impl BlockedConfig {
     };
 }
 
-/// Each leg's count of blocked swings.
+/// Each leg's count of blocked swings, in [`Leg`]'s index order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct BlockedSwings {
     counts: [u8; 4],
@@ -91,7 +91,7 @@ impl BlockedSwings {
     /// `leg`'s foot was measured `lag_m` behind its target along the walking direction at
     /// [`BlockedConfig::at_swing`]; whether the trot is now blocked.
     pub fn swing_measured(&mut self, config: &BlockedConfig, leg: Leg, lag_m: f32) -> bool {
-        let Some(count) = self.counts.get_mut(slot(leg)) else {
+        let Some(count) = self.counts.get_mut(leg as usize) else {
             return false;
         };
         *count = if lag_m > config.at_once_m {
@@ -106,17 +106,7 @@ impl BlockedSwings {
 
     /// `leg`'s count.
     pub fn count(&self, leg: Leg) -> u8 {
-        self.counts.get(slot(leg)).copied().unwrap_or(0)
-    }
-}
-
-/// `leg`'s place in [`BlockedSwings`]'s counts.
-const fn slot(leg: Leg) -> usize {
-    match leg {
-        Leg::Fl => 0,
-        Leg::Fr => 1,
-        Leg::Bl => 2,
-        Leg::Br => 3,
+        self.counts.get(leg as usize).copied().unwrap_or(0)
     }
 }
 

@@ -44,8 +44,9 @@ pub struct FootTrajectory {
 
 impl FootTrajectory {
     /// 8 cm stride, 4 cm clearance, centred 3 cm ahead of the hip, on the ground 55 % of the
-    /// cycle (module docs, "Duty"). Centred under the hip the robot trotted forward (1.3 m in 8 s) but not backward (0.09 m): its knees bend one way,
-    /// so a leg pushes unevenly fore and aft of the hip. Measured in the simulator over 8 s,
+    /// cycle (module docs, "Duty"). Centred under the hip the robot trotted forward (1.3 m in
+    /// 8 s) but not backward (0.09 m): its knees bend one way, so a leg pushes unevenly fore
+    /// and aft of the hip. Measured in the simulator over 8 s,
     /// forward / backward: centre 0 → 1.30 / 0.09 m, +1.5 cm → 1.21 / 0.60 m, +3 cm → 0.96 /
     /// 0.88 m, +4.5 cm → 0.65 / 1.18 m; +3 cm walks both ways alike.
     pub const DEFAULT: Self = Self {

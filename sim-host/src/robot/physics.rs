@@ -331,10 +331,7 @@ impl Physics {
                 };
                 let body = model.geom_bodyid().get(id).copied().unwrap_or(0);
                 if body != 0 {
-                    let name = model
-                        .id_to_name(MjtObj::mjOBJ_GEOM, id)
-                        .unwrap_or("(unnamed)")
-                        .to_owned();
+                    let name = self.geom_name(id).to_owned();
                     if !names.contains(&name) {
                         names.push(name);
                     }

@@ -41,8 +41,8 @@ impl Controller {
             let target = LegJoints::from_array(*self.legs_rad.leg(leg));
             let measured = LegJoints::from_array(*self.sensors.joint_position_rad.leg(leg));
             let lag = lag_m(&self.config.geometry, &target, &measured, sign) / scale;
-            if self.blocked.0.swing_measured(&config, leg, lag) {
-                self.blocked.1 = true;
+            if self.blocked_swings.swing_measured(&config, leg, lag) {
+                self.leg_blocked = true;
                 self.apply(Event::LegBlocked);
                 return;
             }

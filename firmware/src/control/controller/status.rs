@@ -23,7 +23,7 @@ impl Controller {
             faults = faults.with(FaultFlags::LINK_DEGRADED);
         }
         faults = faults.with(self.wheel_fault);
-        if self.blocked.1 {
+        if self.leg_blocked {
             faults = faults.with(FaultFlags::LEG_BLOCKED);
         }
         if self.teleop.interlocked() {

@@ -16,7 +16,7 @@ use sim_host::robot::sensing::DriveSensing;
 use sim_host::robot::variation::Variation;
 use sim_host::scene::{Scene, SceneError};
 use sim_host::session::{self, BusChoice, Clock, FrameSettings, SegmentSpec, SessionConfig};
-use teleop_core::scenario::{mode_name, Scenario};
+use teleop_core::scenario::{mode_name, Scenario, ScenarioError};
 use teleop_core::scripted::PlanStep;
 
 /// What paces a run; the same names as `firmware-host --clock`.
@@ -256,9 +256,22 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
                 .into(),
         );
     }
-    let scenario = match &args.scenario {
-        Some(path) => Some(Scenario::load(path).map_err(|e| e.to_string())?),
-        None => None,
+    // One read of the scenario file: the operator's plan and the simulator's `[scene]`.
+    let (scenario, scenario_scene) = match &args.scenario {
+        Some(path) => {
+            let text = std::fs::read_to_string(path).map_err(|source| {
+                ScenarioError::Read {
+                    path: path.clone(),
+                    source,
+                }
+                .to_string()
+            })?;
+            let scenario = Scenario::parse(path, &text).map_err(|e| e.to_string())?;
+            // Checked even when --scene replaces it: a bad file is an error.
+            let scene = Scene::from_scenario(path, &text).map_err(|e| e.to_string())?;
+            (Some(scenario), scene)
+        }
+        None => (None, None),
     };
     let duration_s = args
         .duration_s
@@ -269,7 +282,7 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
             "--duration-s {duration_s} must be a positive number of seconds"
         ));
     }
-    let model = model_path(&args)?;
+    let model = model_path(&args, scenario_scene)?;
     let config = session_config(&args, scenario.as_ref(), duration_s, model);
     tracing::info!(model = %config.model.display(), bus = %args.bus, "starting");
     let report = session::run(&config).map_err(|e| match e {
@@ -281,22 +294,14 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
     crate::report::print(&args, scenario.as_ref(), &report)
 }
 
-/// The MJCF the run loads: `--scene` (or else the scenario's `[scene]`) around `--model` (or
-/// the shipped robot), written to `--out` as scene.xml; the robot's own file on flat ground.
-fn model_path(args: &RunArgs) -> Result<PathBuf, String> {
+/// The MJCF the run loads: `--scene` (or else the scenario's `[scene]`, `from_scenario`)
+/// around `--model` (or the shipped robot), written to `--out` as scene.xml; the robot's own
+/// file on flat ground.
+fn model_path(args: &RunArgs, from_scenario: Option<Scene>) -> Result<PathBuf, String> {
     let robot = args
         .model
         .clone()
         .unwrap_or_else(|| PathBuf::from(DEFAULT_MODEL));
-    // A scenario's scene is checked even when --scene replaces it: a bad file is an error.
-    let from_scenario = match &args.scenario {
-        Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .map_err(|e| format!("cannot read the scenario {}: {e}", path.display()))?;
-            Scene::from_scenario(path, &text).map_err(|e| e.to_string())?
-        }
-        None => None,
-    };
     match args.scene.or(from_scenario.map(SceneArg::Made)) {
         None | Some(SceneArg::Made(Scene::Flat)) => Ok(robot),
         Some(SceneArg::Obstacles) if args.model.is_none() => Ok(PathBuf::from(OBSTACLES_MODEL)),
