@@ -49,18 +49,32 @@ struct Figures {
     cleared: bool,
 }
 
-/// Stand, then L toward a `height_m` step whose riser is `approach_m` ahead of the front feet,
-/// on the robot of campaign seed `seed`; STOP at [`STOP_AT_S`].
-fn trot_into_step(seed: u64, height_m: f64, approach_m: f64) -> Figures {
+/// Stand, then L toward a `height_m` step whose riser is `approach_m` ahead of the front feet
+/// (`backward`: K toward one as far behind the back feet), on the robot of campaign seed
+/// `seed`; STOP at [`STOP_AT_S`].
+fn trot_into_step(seed: u64, height_m: f64, approach_m: f64, backward: bool) -> Figures {
+    const DEPTH_M: f64 = 1.2;
+    let riser_x_m = if backward {
+        // The plateau lies behind the robot: its far edge is the riser it meets.
+        -(FEET_AHEAD_M + approach_m) - DEPTH_M
+    } else {
+        FEET_AHEAD_M + approach_m
+    };
     let scene = Scene::Step(Step {
         height_m,
-        riser_x_m: FEET_AHEAD_M + approach_m,
-        depth_m: 1.2,
+        riser_x_m,
+        depth_m: DEPTH_M,
     });
-    let path = scene_file(&scene, &format!("seed-{seed}"));
+    let path = scene_file(&scene, &format!("seed-{seed}-{backward}"));
+    let (mode, start_s) = if backward {
+        // As the campaign's K: stood up first.
+        (TeleopMode::TrotBackward, 2.0)
+    } else {
+        (TeleopMode::TrotForward, 1.0)
+    };
     let plan = vec![
         PlanStep::at(0.0, TeleopMode::Stand),
-        PlanStep::at(1.0, TeleopMode::TrotForward),
+        PlanStep::at(start_s, mode),
         PlanStep::at(STOP_AT_S, TeleopMode::Stop),
     ];
     let plant = Draws::of(seed).plant(Drives::Rated.ratings());
@@ -96,31 +110,65 @@ fn trot_into_step(seed: u64, height_m: f64, approach_m: f64) -> Figures {
     f
 }
 
+/// Seeded trials of a trot into a riser `height_m` ± 1 cm high, 0.2–0.6 m away (the issue's
+/// approach); how many stopped with `leg_blocked`, and the figures of those that did not.
+fn trials(trials: u64, height_m: f64, backward: bool) -> (u64, Vec<Figures>) {
+    let mut stopped = 0;
+    let mut others = Vec::new();
+    for seed in 0..trials {
+        let mut draw = Draw::new(seed ^ 0x0b57_ac1e);
+        let approach_m = 0.2 + 0.4 * draw.unit();
+        let height_m = height_m + 0.02 * (draw.unit() - 0.5);
+        let f = trot_into_step(seed, height_m, approach_m, backward);
+        println!(
+            "MEASURED {} seed {}, {:.3} m step {:.2} m away: {f:?}",
+            if backward { "K" } else { "L" },
+            f.seed,
+            f.height_m,
+            f.approach_m
+        );
+        let safe_stop = f.contact_s.is_some()
+            && !f.fell
+            && f.max_tilt_deg < 20.0
+            && f.blocked.is_some_and(|(blocked_s, state)| {
+                f.contact_s
+                    .is_some_and(|contact_s| blocked_s - contact_s < 8.0)
+                    && state == Some(State::Legs(LegMotion::Stand))
+            })
+            && (backward || f.after_m < 0.10)
+            && f.cleared;
+        if safe_stop {
+            stopped += 1;
+        } else {
+            others.push(f);
+        }
+    }
+    (stopped, others)
+}
+
 #[test]
 fn a_trot_into_a_step_it_cannot_clear_stops_and_says_why() {
     const TRIALS: u64 = 16;
-    let mut stopped = 0;
-    for seed in 0..TRIALS {
-        // The approach: 0.2–0.6 m, the height ±1 cm.
-        let mut draw = Draw::new(seed ^ 0x0b57_ac1e);
-        let approach_m = 0.2 + 0.4 * draw.unit();
-        let height_m = 0.10 + 0.02 * (draw.unit() - 0.5);
-        let f = trot_into_step(seed, height_m, approach_m);
-        println!(
-            "MEASURED seed {}, {:.3} m step {:.2} m ahead: {f:?}",
-            f.seed, f.height_m, f.approach_m
-        );
-        let contact_s = f.contact_s.expect("never reached the step");
-        assert!(!f.fell, "{f:?}");
-        assert!(f.max_tilt_deg < 20.0, "{f:?}");
-        let (blocked_s, state) = f.blocked.expect("never reported");
-        assert!(blocked_s - contact_s < 8.0, "{f:?}");
-        assert_eq!(state, Some(State::Legs(LegMotion::Stand)), "{f:?}");
-        assert!(f.after_m < 0.10, "{f:?}");
-        assert!(f.cleared, "{f:?}");
-        stopped += 1;
+    let (stopped, others) = trials(TRIALS, 0.10, false);
+    println!("MEASURED L into 10 cm: stopped with leg_blocked {stopped} of {TRIALS}");
+    assert!(others.is_empty(), "{others:#?}");
+}
+
+/// Walking backward the back feet are watched as the front feet are forward, with a lower
+/// threshold for a single swing ([`firmware::legs::blocked::BlockedConfig`]). A riser behind
+/// the robot is the harder case: the back feet land on its edge as often as it stops them,
+/// and a trot on feet a riser apart in height tips over. Before the back feet were watched,
+/// 11 of 16 trots into a 6 cm riser behind fell (seeds 0–15, the riser 0.3 m behind). After
+/// the report a robot shoved by the riser moves up to 0.19 m (forward, under 0.1 m).
+#[test]
+fn a_backward_trot_into_a_riser_mostly_stops_before_it_falls() {
+    const TRIALS: u64 = 16;
+    for (height_m, least) in [(0.10, 14), (0.06, 11)] {
+        let (stopped, others) = trials(TRIALS, height_m, true);
+        let fell = others.iter().filter(|f| f.fell).count();
+        println!("MEASURED K into {height_m} m: stopped {stopped} of {TRIALS}, fell {fell}");
+        assert!(stopped >= least, "{height_m} m: {others:#?}");
     }
-    println!("MEASURED stopped with leg_blocked: {stopped} of {TRIALS}");
 }
 
 #[test]

@@ -172,7 +172,14 @@ impl Trot {
             Generator::Sine(_) => return None,
         };
         let fraction = self.leg_phase(leg, direction).fraction();
-        (fraction >= duty).then(|| (fraction - duty) / (1.0 - duty))
+        // Walking backward the phase runs backward: the swing is traversed from its end.
+        (fraction >= duty).then(|| {
+            let share = (fraction - duty) / (1.0 - duty);
+            match direction {
+                Direction::Forward => share,
+                Direction::Backward => 1.0 - share,
+            }
+        })
     }
 
     /// Joint targets of all four legs (in [`Leg::ALL`] order) at the present phase, for a
