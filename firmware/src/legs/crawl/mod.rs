@@ -19,14 +19,17 @@
 //! [`CrawlConfig::blocked_lag_m`] has met a riser taller than the lift ([`Outcome::Blocked`]).
 
 pub mod frame;
+mod loads;
+mod swing;
 
 use protocol::{Joints, Leg};
 
 use crate::legs::kinematics::{IkError, LegGeometry, LegJoints};
 use crate::limits::JointLimits;
-use crate::math::{clamp, cos};
 use crate::time::TickRate;
 use frame::{BodyPose, CrawlGeometry, PerLeg, Point};
+pub use loads::foot_loads_n;
+use swing::{smooth, swing_point, SwingStage};
 
 /// Tunables of a crawl's moves.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -50,6 +53,10 @@ pub struct CrawlConfig {
     pub blocked_lag_m: f32,
     /// How far under where it touched a landed foot's target stays, so that it carries, m.
     pub preload_m: f32,
+    /// A foot that carries no more than this share of the weight is free to lift.
+    pub unloaded_share: f32,
+    /// How fast the body sways to free a foot, m/s.
+    pub unload_m_s: f32,
 }
 
 impl CrawlConfig {
@@ -64,6 +71,8 @@ impl CrawlConfig {
         search_below_m: 0.04,
         blocked_lag_m: 0.03,
         preload_m: 0.005,
+        unloaded_share: 0.1,
+        unload_m_s: 0.04,
     };
 }
 
@@ -76,6 +85,17 @@ pub enum Move {
         to: BodyPose,
         /// How long it takes, ms.
         ms: u32,
+    },
+    /// The body away from `leg`'s foot, at a steady speed, until that foot carries no more than
+    /// [`CrawlConfig::unloaded_share`] of the weight ([`foot_loads_n`]) or the body has gone
+    /// `max_m`. The legs' servos are compliant and the centre of mass is not where the
+    /// drawing puts it, so a sway is judged by the loads it leaves on the feet, not by its
+    /// commanded length.
+    Unload {
+        /// The foot to free.
+        leg: Leg,
+        /// The longest sway, m.
+        max_m: f32,
     },
     /// One foot up by `lift_m` above where it stands, over to `to` (x, y), and down.
     Swing {
@@ -112,20 +132,17 @@ pub enum Outcome {
     },
 }
 
-/// Where a swing is.
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum SwingStage {
-    Lift,
-    Carry,
-    Lower,
-    /// Going back down where it stood after a block.
-    Retreat,
-}
-
 /// The move under way.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Running {
     Idle,
+    Unload {
+        leg: Leg,
+        from: BodyPose,
+        /// Unit direction of the sway (x, y).
+        direction: (f32, f32),
+        max_m: f32,
+    },
     Body {
         from: BodyPose,
         to: BodyPose,
@@ -183,6 +200,12 @@ impl Crawl {
     pub fn start(&mut self, next: Move) {
         self.elapsed = 0;
         self.running = match next {
+            Move::Unload { leg, max_m } => Running::Unload {
+                leg,
+                from: self.body,
+                direction: self.away_from(leg),
+                max_m,
+            },
             Move::Body { to, ms } => Running::Body {
                 from: self.body,
                 to,
@@ -200,6 +223,20 @@ impl Crawl {
                 }
             }
         };
+    }
+
+    /// The unit direction (x, y) of the sway that leaves `leg`'s load to the other three
+    /// feet: sideways, away from the foot's side. (A sway toward the middle of the feet also
+    /// moved the body along them, and it loaded the hips of the legs it moved over until they
+    /// saturated at their rating.)
+    fn away_from(&self, leg: Leg) -> (f32, f32) {
+        let f = self.feet;
+        let mid_y = 0.25 * (f.fl.y_m + f.fr.y_m + f.bl.y_m + f.br.y_m);
+        if f.get(leg).y_m > mid_y {
+            (0.0, -1.0)
+        } else {
+            (0.0, 1.0)
+        }
     }
 
     /// Where `leg`'s foot is commanded now.
@@ -244,9 +281,65 @@ impl Crawl {
         measured_rad: &Joints<f32>,
         effort_nm: &Joints<f32>,
     ) -> Option<Outcome> {
+        let outcome = self.advance(config, geometry, limits, measured_rad, effort_nm);
+        if outcome.is_some() {
+            self.reanchor(config, geometry, measured_rad);
+        }
+        outcome
+    }
+
+    /// Takes every foot's position along the ground from where the encoders put it, its
+    /// height from its target. A foot that slipped, or a leg pushed off its target along the
+    /// ground by the others, would otherwise leave the legs pushing against each other with
+    /// the error times the servos' stiffness (5 cm of it saturated a hip at its 30 N·m
+    /// rating); a leg sagging under its load keeps its target height, and with it its load.
+    fn reanchor(
+        &mut self,
+        config: &CrawlConfig,
+        geometry: &LegGeometry,
+        measured_rad: &Joints<f32>,
+    ) {
+        for leg in Leg::ALL {
+            let joints = LegJoints::from_array(*measured_rad.leg(leg));
+            let measured = config.geometry.foot_of(geometry, &self.body, leg, &joints);
+            let foot = self.feet.get_mut(leg);
+            if measured.x_m.is_finite() && measured.y_m.is_finite() {
+                foot.x_m = measured.x_m;
+                foot.y_m = measured.y_m;
+            }
+        }
+    }
+
+    /// One tick of the move under way; `Some` when it ends.
+    fn advance(
+        &mut self,
+        config: &CrawlConfig,
+        geometry: &LegGeometry,
+        limits: &JointLimits,
+        measured_rad: &Joints<f32>,
+        effort_nm: &Joints<f32>,
+    ) -> Option<Outcome> {
         self.elapsed = self.elapsed.saturating_add(1);
         match self.running {
             Running::Idle => None,
+            Running::Unload {
+                leg,
+                from,
+                direction: (dx, dy),
+                max_m,
+            } => {
+                let loads = foot_loads_n(geometry, measured_rad, effort_nm);
+                let total = loads.fl + loads.fr + loads.bl + loads.br;
+                let unloaded = total > 0.0 && loads.get(leg) <= config.unloaded_share * total;
+                let moved_m = config.unload_m_s * self.elapsed as f32 * self.rate.period_s();
+                let moved_m = moved_m.min(max_m);
+                self.body.centre.x_m = from.centre.x_m + dx * moved_m;
+                self.body.centre.y_m = from.centre.y_m + dy * moved_m;
+                (unloaded || moved_m >= max_m).then(|| {
+                    self.running = Running::Idle;
+                    Outcome::Moved
+                })
+            }
             Running::Body { from, to, ticks } => {
                 let share = self.elapsed as f32 / ticks as f32;
                 self.body = from.toward(&to, smooth(share));
@@ -359,50 +452,6 @@ impl Crawl {
         self.running = Running::Idle;
         Some(outcome)
     }
-}
-
-/// The foot's point in a swing at `stage`, `stage_ticks` in.
-fn swing_point(
-    config: &CrawlConfig,
-    rate: TickRate,
-    from: &Point,
-    to: &Point,
-    top_z_m: f32,
-    stage: SwingStage,
-    stage_ticks: u32,
-) -> Point {
-    let share = |ms: u32| {
-        let ticks = rate.ticks_from_ms(ms).max(1);
-        smooth(stage_ticks as f32 / ticks as f32)
-    };
-    match stage {
-        SwingStage::Lift => Point {
-            z_m: from.z_m + (top_z_m - from.z_m) * share(config.lift_ms),
-            ..*from
-        },
-        SwingStage::Carry => {
-            let s = share(config.carry_ms);
-            Point {
-                x_m: from.x_m + (to.x_m - from.x_m) * s,
-                y_m: from.y_m + (to.y_m - from.y_m) * s,
-                z_m: top_z_m,
-            }
-        }
-        SwingStage::Lower => Point {
-            z_m: top_z_m - config.lower_m_s * stage_ticks as f32 * rate.period_s(),
-            ..*to
-        },
-        SwingStage::Retreat => Point {
-            z_m: top_z_m + (from.z_m - top_z_m) * share(config.lift_ms),
-            ..*from
-        },
-    }
-}
-
-/// A smooth start and stop over a share 0…1 (half a cosine).
-fn smooth(share: f32) -> f32 {
-    let s = clamp(share, 0.0, 1.0);
-    0.5 * (1.0 - cos(core::f32::consts::PI * s))
 }
 
 #[cfg(test)]

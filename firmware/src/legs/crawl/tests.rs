@@ -35,19 +35,45 @@ fn standing_at(depth_m: f32) -> Crawl {
     )
 }
 
-/// Runs the crawl's move on a plant whose feet follow their targets, except that a foot
-/// cannot go below `ground_z_m(x)` nor pass forward of `wall_x_m` below `wall_top_z_m`.
-fn run(
-    crawl: &mut Crawl,
-    ground_z_m: impl Fn(f32) -> f32,
+/// What the test plant does besides following the targets.
+#[derive(Default)]
+struct Plant<'a> {
+    /// The ground's height under x (none: no ground within reach).
+    ground_z_m: Option<&'a dyn Fn(f32) -> f32>,
+    /// A wall no foot passes forward of below its top: (x, top z).
     wall: Option<(f32, f32)>,
-) -> Option<Outcome> {
+    /// A foot that slipped along the ground: its measured x is this far off its target.
+    slip: Option<(Leg, f32)>,
+    /// Each foot's vertical load, N, as its drives' torques report it.
+    loads_n: PerLeg<f32>,
+}
+
+/// The torques a leg's drives apply to hold a vertical load `fz_n` at rest, by virtual work on
+/// the leg's FK (independently of [`crate::legs::kinematics::foot_force_n`]).
+fn holding_torques_nm(geometry: &LegGeometry, joints: &LegJoints, fz_n: f32) -> [f32; 4] {
+    let step = 1e-3_f32;
+    let dz = |bump: fn(&mut LegJoints, f32)| {
+        let (mut plus, mut minus) = (*joints, *joints);
+        bump(&mut plus, step);
+        bump(&mut minus, -step);
+        let a = crate::legs::kinematics::leg_fk(geometry, &plus).z_m;
+        let b = crate::legs::kinematics::leg_fk(geometry, &minus).z_m;
+        (a - b) / (2.0 * step)
+    };
+    let hip = -dz(|j, d| j.hip_pitch_rad += d) * fz_n;
+    let knee = -dz(|j, d| j.knee_rad += d) * fz_n;
+    [0.0, hip, knee, 0.0]
+}
+
+/// Runs the crawl's move on a plant whose feet follow their targets, but for the `plant`.
+fn run_on(crawl: &mut Crawl, plant: &Plant<'_>) -> Option<Outcome> {
     let config = CrawlConfig::ROBOT;
     let geometry = LegGeometry::ROBOT;
     let limits = JointLimits::REPORT;
     for _ in 0..5_000_u32 {
         let targets = crawl.targets(&config, &geometry, &limits);
         let mut measured = Joints::splat(0.0);
+        let mut effort = Joints::splat(0.0);
         for (leg, target) in Leg::ALL.into_iter().zip(targets) {
             let Ok(joints) = target else {
                 return None;
@@ -55,39 +81,47 @@ fn run(
             let mut foot = config
                 .geometry
                 .foot_of(&geometry, &crawl.body(), leg, &joints);
-            if let Some((wall_x_m, top_z_m)) = wall {
+            if let Some((wall_x_m, top_z_m)) = plant.wall {
                 if foot.z_m < top_z_m && foot.x_m > wall_x_m {
                     foot.x_m = wall_x_m;
                 }
             }
-            foot.z_m = foot.z_m.max(ground_z_m(foot.x_m));
-            let local = config.geometry.to_leg(&crawl.body(), leg, &foot);
-            let solved = crate::legs::kinematics::leg_ik(
-                &geometry,
-                &JointLimits::REPORT,
-                &crate::legs::kinematics::FootTarget {
-                    x_m: local.x_m,
-                    y_m: local.y_m,
-                    z_m: local.z_m,
-                    pitch_rad: -1.6,
-                },
-                crate::legs::kinematics::KneeBranch::Down,
-            )
-            .or_else(|_| {
-                config
-                    .geometry
-                    .solve(&geometry, &limits, &crawl.body(), leg, &foot)
-            })
-            .unwrap_or(joints);
+            if let Some(ground) = plant.ground_z_m {
+                foot.z_m = foot.z_m.max(ground(foot.x_m));
+            }
+            if let Some((slipped, dx_m)) = plant.slip {
+                if slipped == leg {
+                    foot.x_m += dx_m;
+                }
+            }
+            let solved = config
+                .geometry
+                .solve(&geometry, &limits, &crawl.body(), leg, &foot)
+                .unwrap_or(joints);
             *measured.leg_mut(leg) = solved.to_array();
+            *effort.leg_mut(leg) = holding_torques_nm(&geometry, &solved, plant.loads_n.get(leg));
         }
-        if let Some(outcome) =
-            crawl.tick(&config, &geometry, &limits, &measured, &Joints::splat(0.0))
-        {
+        if let Some(outcome) = crawl.tick(&config, &geometry, &limits, &measured, &effort) {
             return Some(outcome);
         }
     }
     None
+}
+
+/// [`run_on`] a plant with the ground at `ground_z_m(x)` and maybe a wall.
+fn run(
+    crawl: &mut Crawl,
+    ground_z_m: &dyn Fn(f32) -> f32,
+    wall: Option<(f32, f32)>,
+) -> Option<Outcome> {
+    run_on(
+        crawl,
+        &Plant {
+            ground_z_m: Some(ground_z_m),
+            wall,
+            ..Plant::default()
+        },
+    )
 }
 
 #[test]
@@ -110,7 +144,7 @@ fn a_swing_lands_on_a_step_and_the_foot_stays_there() {
         },
         lift_m: 0.06,
     });
-    let outcome = run(&mut crawl, step, None);
+    let outcome = run(&mut crawl, &step, None);
     assert!(
         matches!(outcome, Some(Outcome::Landed { leg: Leg::Fl, .. })),
         "{outcome:?}"
@@ -137,7 +171,7 @@ fn a_swing_into_a_riser_taller_than_its_lift_is_blocked_and_goes_back_down() {
     });
     let wall = Some((start.x_m + 0.02, start.z_m + 0.10));
     assert_eq!(
-        run(&mut crawl, |_| -1.0, wall),
+        run(&mut crawl, &|_| -1.0, wall),
         Some(Outcome::Blocked { leg: Leg::Fr })
     );
     assert_eq!(crawl.feet().fr, start);
@@ -156,7 +190,7 @@ fn a_swing_over_a_hole_finds_no_ground() {
         lift_m: 0.03,
     });
     assert_eq!(
-        run(&mut crawl, |_| -1.0, None),
+        run(&mut crawl, &|_| -1.0, None),
         Some(Outcome::NoGround { leg: Leg::Bl })
     );
 }
@@ -174,7 +208,67 @@ fn a_body_move_keeps_the_feet_where_they_stand() {
         pitch_rad: 0.1,
     };
     crawl.start(Move::Body { to, ms: 400 });
-    assert_eq!(run(&mut crawl, |_| -1.0, None), Some(Outcome::Moved));
+    assert_eq!(run(&mut crawl, &|_| -1.0, None), Some(Outcome::Moved));
     assert_eq!(crawl.body(), to);
-    assert_eq!(crawl.feet(), feet);
+    // Re-anchored where the encoders put them: within rounding of where they stood.
+    for leg in Leg::ALL {
+        let (a, b) = (crawl.feet().get(leg), feet.get(leg));
+        assert!((a.x_m - b.x_m).abs() < 1e-4 && (a.y_m - b.y_m).abs() < 1e-4 && a.z_m == b.z_m);
+    }
+}
+
+#[test]
+fn an_unload_sways_sideways_away_from_the_foot_until_it_carries_little() {
+    // Nothing reported: the sway goes its whole length, away from the left front foot.
+    let mut crawl = standing();
+    crawl.start(Move::Unload {
+        leg: Leg::Fl,
+        max_m: 0.04,
+    });
+    assert_eq!(run(&mut crawl, &|_| -1.0, None), Some(Outcome::Moved));
+    let body = crawl.body();
+    assert!((body.centre.y_m + 0.04).abs() < 1e-4, "{body:?}");
+    assert!(body.centre.x_m.abs() < 1e-6, "{body:?}");
+    // The foot already carries 5 of 305 N: the sway ends at once.
+    let mut crawl = standing();
+    crawl.start(Move::Unload {
+        leg: Leg::Br,
+        max_m: 0.04,
+    });
+    let plant = Plant {
+        ground_z_m: Some(&|_| -1.0),
+        loads_n: PerLeg {
+            fl: 100.0,
+            fr: 100.0,
+            bl: 100.0,
+            br: 5.0,
+        },
+        ..Plant::default()
+    };
+    assert_eq!(run_on(&mut crawl, &plant), Some(Outcome::Moved));
+    let body = crawl.body();
+    assert!(body.centre.y_m > 0.0 && body.centre.y_m < 0.001, "{body:?}");
+}
+
+#[test]
+fn a_foot_that_slipped_is_taken_where_the_encoders_put_it() {
+    let mut crawl = standing();
+    let before = crawl.feet();
+    crawl.start(Move::Body {
+        to: BodyPose::default(),
+        ms: 100,
+    });
+    let plant = Plant {
+        ground_z_m: Some(&|_| -1.0),
+        slip: Some((Leg::Bl, -0.02)),
+        ..Plant::default()
+    };
+    assert_eq!(run_on(&mut crawl, &plant), Some(Outcome::Moved));
+    let after = crawl.feet();
+    assert!(
+        (after.bl.x_m - (before.bl.x_m - 0.02)).abs() < 1e-3,
+        "{after:?}"
+    );
+    assert_eq!(after.bl.z_m, before.bl.z_m, "the height stays the target's");
+    assert!((after.fl.x_m - before.fl.x_m).abs() < 1e-4);
 }

@@ -1,0 +1,28 @@
+//! Each foot's load from what its drives report: the crawl frees a foot by the loads its
+//! sway leaves on the feet, not by the sway's commanded length.
+
+use protocol::{Joints, Leg};
+
+use super::frame::PerLeg;
+use crate::legs::kinematics::{LegGeometry, LegJoints};
+
+/// Each foot's vertical load, N, from its leg's measured angles and the torques its hip and
+/// knee drives report (negative and undetermined count as none).
+pub fn foot_loads_n(
+    geometry: &LegGeometry,
+    measured_rad: &Joints<f32>,
+    effort_nm: &Joints<f32>,
+) -> PerLeg<f32> {
+    let load = |leg: Leg| {
+        let joints = LegJoints::from_array(*measured_rad.leg(leg));
+        let [_, hip_pitch_nm, knee_nm, _] = *effort_nm.leg(leg);
+        crate::legs::kinematics::foot_force_n(geometry, &joints, hip_pitch_nm, knee_nm)
+            .map_or(0.0, |(_, fz_n)| fz_n.max(0.0))
+    };
+    PerLeg {
+        fl: load(Leg::Fl),
+        fr: load(Leg::Fr),
+        bl: load(Leg::Bl),
+        br: load(Leg::Br),
+    }
+}
