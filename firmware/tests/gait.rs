@@ -215,3 +215,35 @@ fn every_gait_pose_solves_across_the_body_height_band_and_speed_scales() {
         }
     }
 }
+
+/// The blocked-swing watch measures a leading foot at 70 % of its swing, so the swing's share
+/// must run from lift-off to touchdown whichever way the robot walks (walking backward the
+/// phase runs backward, and the share once ran from touchdown to lift-off).
+#[test]
+fn a_swing_is_counted_from_lift_off_in_both_directions() {
+    for direction in [Direction::Forward, Direction::Backward] {
+        let mut trot = Trot::new(TrotParams::DEFAULT, TickRate::SIM_250_HZ).unwrap();
+        let (mut last, mut rises, mut falls, mut first) = (None, 0, 0, None);
+        for _ in 0..2 * 250 {
+            let share = trot.swing_share(Leg::Bl, direction);
+            match (last, share) {
+                (Some(a), Some(b)) if b > a => rises += 1,
+                (Some(_), Some(_)) => falls += 1,
+                (None, Some(b)) => {
+                    first.get_or_insert(b);
+                }
+                _ => {}
+            }
+            last = share;
+            trot.advance();
+        }
+        assert!(
+            rises > 150 && falls == 0,
+            "{direction:?}: {rises} up, {falls} down"
+        );
+        assert!(
+            first.is_some_and(|f: f32| f < 0.05),
+            "{direction:?}: starts at {first:?}"
+        );
+    }
+}

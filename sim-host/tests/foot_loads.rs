@@ -1,6 +1,6 @@
 //! The feet's loads as the firmware can know them (`firmware::legs::crawl::foot_loads_n`: each
 //! leg's measured angles and the hip and knee torques its drive reports, with the drive's
-//! gain error), against the contact forces MuJoCo computes, on robots standing and walking.
+//! gain error), against the contact forces MuJoCo computes, on robots standing.
 //!
 //! `cargo test --release -p sim-host --test foot_loads -- --nocapture` prints the figures.
 
@@ -42,7 +42,7 @@ fn loads(plant: Plant, plan: Vec<PlanStep>, until_s: f64) -> [(f32, f32); 4] {
 }
 
 #[test]
-fn standing_robots_read_each_foots_load_within_a_tenth_of_their_weight() {
+fn standing_robots_read_each_foots_load_within_6_percent_of_their_weight() {
     let plan = vec![PlanStep::at(0.0, TeleopMode::Stand)];
     let mut plants = vec![("as drawn".to_string(), Plant::default())];
     for seed in 0..6 {
@@ -57,7 +57,7 @@ fn standing_robots_read_each_foots_load_within_a_tenth_of_their_weight() {
         println!("MEASURED {name}: (estimated, simulated) N {feet:.0?}");
         for (estimated, simulated) in feet {
             assert!(
-                (estimated - simulated).abs() < 0.1 * weight_n,
+                (estimated - simulated).abs() < 0.06 * weight_n,
                 "{name}: {feet:?}"
             );
         }

@@ -21,6 +21,10 @@ use teleop_core::scripted::PlanStep;
 /// the hips at 0.22 m, and the foot's radius).
 const FEET_AHEAD_M: f64 = 0.28;
 
+/// The back feet's rear stands this far behind the torso's centre, m (the stance under the
+/// hips at 0.22 m, and the foot's radius).
+const FEET_BEHIND_M: f64 = 0.255;
+
 /// The operator's STOP after the run, s: it clears the report.
 const STOP_AT_S: f64 = 20.0;
 
@@ -56,7 +60,7 @@ fn trot_into_step(seed: u64, height_m: f64, approach_m: f64, backward: bool) -> 
     const DEPTH_M: f64 = 1.2;
     let riser_x_m = if backward {
         // The plateau lies behind the robot: its far edge is the riser it meets.
-        -(FEET_AHEAD_M + approach_m) - DEPTH_M
+        -(FEET_BEHIND_M + approach_m) - DEPTH_M
     } else {
         FEET_AHEAD_M + approach_m
     };
@@ -135,7 +139,7 @@ fn trials(trials: u64, height_m: f64, backward: bool) -> (u64, Vec<Figures>) {
                     .is_some_and(|contact_s| blocked_s - contact_s < 8.0)
                     && state == Some(State::Legs(LegMotion::Stand))
             })
-            && (backward || f.after_m < 0.10)
+            && f.after_m < if backward { 0.2 } else { 0.10 }
             && f.cleared;
         if safe_stop {
             stopped += 1;
@@ -159,11 +163,11 @@ fn a_trot_into_a_step_it_cannot_clear_stops_and_says_why() {
 /// the robot is the harder case: the back feet land on its edge as often as it stops them,
 /// and a trot on feet a riser apart in height tips over. Before the back feet were watched,
 /// 11 of 16 trots into a 6 cm riser behind fell (seeds 0–15, the riser 0.3 m behind). After
-/// the report a robot shoved by the riser moves up to 0.19 m (forward, under 0.1 m).
+/// the report a robot shoved by the riser moves up to 0.16 m (forward, under 0.1 m).
 #[test]
 fn a_backward_trot_into_a_riser_mostly_stops_before_it_falls() {
     const TRIALS: u64 = 16;
-    for (height_m, least) in [(0.10, 14), (0.06, 11)] {
+    for (height_m, least) in [(0.10, 14), (0.06, 12)] {
         let (stopped, others) = trials(TRIALS, height_m, true);
         let fell = others.iter().filter(|f| f.fell).count();
         println!("MEASURED K into {height_m} m: stopped {stopped} of {TRIALS}, fell {fell}");
@@ -194,7 +198,10 @@ fn on_flat_ground_the_watch_never_stops_a_trot() {
                 .filter(|r| r.faults.contains(FaultFlags::LEG_BLOCKED))
                 .count();
             let [x, y, _] = rig.sim().physics().torso().pos_m;
-            println!("MEASURED seed {seed} {mode:?} 24 s on flat ground: at ({x:.2}, {y:.2}) m, {blocked} cycles blocked");
+            println!(
+                "MEASURED seed {seed} {mode:?} 24 s on flat ground: at ({x:.2}, {y:.2}) m, \
+                 {blocked} cycles blocked"
+            );
             assert_eq!(blocked, 0, "seed {seed} {mode:?}");
             // The trot walked all along (the campaign's L and K ask 0.4 m in 8 s); the trot
             // holds no heading, and some robots walk a circle (robot 6: 136° in 24 s).

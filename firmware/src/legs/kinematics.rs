@@ -305,35 +305,51 @@ pub fn leg_ik(
     }
 }
 
-/// The ground's force on the foot, in the leg's sagittal plane (x forward, z up), N, from the
-/// hip-pitch and knee torques the drives apply (`τ = −Jᵀ F` at rest, the foot a point):
-/// `(fx_n, fz_n)`. `None` where the two rows do not determine it (a straight leg) or for
-/// non-finite input.
+/// The ground's force on a foot, in the leg's sagittal plane (x forward, z up along the leg
+/// frame: vertical while the body is level and the hip not abducted), N.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FootForce {
+    /// Forward, N.
+    pub fx_n: f32,
+    /// Up, N.
+    pub fz_n: f32,
+}
+
+/// Below this `|det J|` (m²) of the hip and knee rows the leg is too nearly straight for its
+/// torques to tell the force.
+const STRAIGHT_LEG_DET_M2: f32 = 1e-4;
+
+/// The ground's force on the foot from the hip-pitch and knee torques the drives apply, at
+/// rest and with the foot a point (`τ = −Jᵀ F`). `None` where the two rows do not determine it
+/// (a nearly straight leg) or for non-finite input.
 pub fn foot_force_n(
     geometry: &LegGeometry,
     joints: &LegJoints,
     hip_pitch_nm: f32,
     knee_nm: f32,
-) -> Option<(f32, f32)> {
-    let a1 = joints.hip_pitch_rad - FRAC_PI_2;
-    let a2 = a1 + joints.knee_rad;
-    let a3 = a2 + joints.ankle_rad;
-    let (s1, c1) = (sin(a1), cos(a1));
-    let (s2, c2) = (sin(a2), cos(a2));
-    let (s3, c3) = (sin(a3), cos(a3));
-    let (l1, l2, l3) = (geometry.l1_m, geometry.l2_m, geometry.l3_m);
-    let x = l1 * c1 + l2 * c2 + l3 * c3;
-    let z = l1 * s1 + l2 * s2 + l3 * s3;
-    // Rows of Jᵀ: d(x, z)/dq1 = (−z, x), d(x, z)/dq2 = (−(l2 s12 + l3 s123), l2 c12 + l3 c123).
-    let (a, b) = (-z, x);
-    let (c, d) = (-(l2 * s2 + l3 * s3), l2 * c2 + l3 * c3);
+) -> Option<FootForce> {
+    let angles = PlanarAngles {
+        q1_rad: joints.hip_pitch_rad - FRAC_PI_2,
+        q2_rad: joints.knee_rad,
+        q3_rad: joints.ankle_rad,
+    };
+    let foot = planar_fk(geometry, &angles);
+    let knee_angle = angles.q1_rad + angles.q2_rad;
+    // d(x, z)/dq1 = (−z, x); d(x, z)/dq2 is the same for the chain below the knee.
+    let (below_x, below_z) = (
+        geometry.l2_m * cos(knee_angle) + geometry.l3_m * cos(foot.pitch_rad),
+        geometry.l2_m * sin(knee_angle) + geometry.l3_m * sin(foot.pitch_rad),
+    );
+    let (a, b) = (-foot.z_m, foot.x_m);
+    let (c, d) = (-below_z, below_x);
     let det = a * d - b * c;
-    if !(det.is_finite() && det.abs() > 1e-4) {
+    if !(det.is_finite() && det.abs() > STRAIGHT_LEG_DET_M2) {
         return None;
     }
-    // −τ = Jᵀ F.
     let (t1, t2) = (-hip_pitch_nm, -knee_nm);
-    let fx = (d * t1 - b * t2) / det;
-    let fz = (a * t2 - c * t1) / det;
-    (fx.is_finite() && fz.is_finite()).then_some((fx, fz))
+    let force = FootForce {
+        fx_n: (d * t1 - b * t2) / det,
+        fz_n: (a * t2 - c * t1) / det,
+    };
+    (force.fx_n.is_finite() && force.fz_n.is_finite()).then_some(force)
 }

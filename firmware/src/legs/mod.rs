@@ -1,9 +1,9 @@
 //! The legs: [`kinematics`] (IK/FK of one leg), the poses ([`posture`]: the stance; the fold and
-//! its [`levelling`]), the
-//! trot ([`gait`] with its [`phase`] clock, [`foot_trajectory`], the watch for a swing it
-//! cannot finish ([`blocked`]), the quasi-static [`crawl`] (moves for a climb, not used yet) and the report's
-//! [`sine_gait`]), [`smoothing`] of targets, joint-space [`ramp`]s, the [`transfer`] from the
-//! legs onto the wheels and [`support`] (which feet carry the robot).
+//! its [`levelling`]), the trot ([`gait`] with its [`phase`] clock, [`foot_trajectory`], the
+//! watch for a swing it cannot finish ([`blocked`]) and the report's [`sine_gait`]), the
+//! quasi-static [`crawl`] (moves for a climb, not used yet), [`smoothing`] of targets,
+//! joint-space [`ramp`]s, the [`transfer`] from the legs onto the wheels and [`support`] (which
+//! feet carry the robot).
 
 pub mod blocked;
 pub mod crawl;

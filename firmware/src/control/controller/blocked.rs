@@ -10,7 +10,8 @@ use crate::legs::kinematics::LegJoints;
 
 impl Controller {
     /// One tick of the watch, before the trot's phase advances: a leading foot (the front feet
-    /// walking forward, the back feet walking backward) that passes [`crate::legs::blocked::BlockedConfig::at_swing`] of its swing with this
+    /// walking forward, the back feet walking backward) that passes
+    /// [`crate::legs::blocked::BlockedConfig::at_swing`] of its swing with this
     /// tick is measured against its target; a leg blocked swing after swing stops the trot
     /// ([`Event::LegBlocked`]: the robot stands on four legs) and the controller reports
     /// [`protocol::FaultFlags::LEG_BLOCKED`] until the operator's next request.
@@ -42,11 +43,10 @@ impl Controller {
             let target = LegJoints::from_array(*self.legs_rad.leg(leg));
             let measured = LegJoints::from_array(*self.sensors.joint_position_rad.leg(leg));
             let lag = lag_m(&self.config.geometry, &target, &measured, sign) / scale;
-            let once = match direction {
-                Direction::Forward => config.at_once_m,
-                Direction::Backward => config.backward_at_once_m,
-            };
-            if self.blocked_swings.swing_measured(&config, leg, lag, once) {
+            if self
+                .blocked_swings
+                .swing_measured(&config, leg, lag, direction)
+            {
                 self.leg_blocked = true;
                 self.apply(Event::LegBlocked);
                 return;

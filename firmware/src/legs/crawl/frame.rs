@@ -266,7 +266,7 @@ mod tests {
     }
 
     #[test]
-    fn the_schedule_solves_a_foot_lifted_high_behind_a_pitched_hip() {
+    fn the_schedule_solves_a_foot_lifted_high_behind_a_level_hip() {
         let g = CrawlGeometry::ROBOT;
         let body = BodyPose::default();
         let hip = g.hip(&body, Leg::Fl);
@@ -287,5 +287,60 @@ mod tests {
             );
             assert!((back.x_m - foot.x_m).abs() < 1e-4 && (back.z_m - foot.z_m).abs() < 1e-4);
         }
+    }
+
+    /// The smallest distance of the pitch joints from their range's ends for the foot at
+    /// `(x_m, depth_m)` with foot pitch `pitch_rad`, rad (negative: outside, or unreachable).
+    fn margin_rad(x_m: f32, depth_m: f32, pitch_rad: f32) -> f32 {
+        use crate::legs::kinematics::{planar_ik, KneeBranch, PlanarPose};
+        use crate::limits::Joint;
+        let pose = PlanarPose {
+            x_m,
+            z_m: -depth_m,
+            pitch_rad,
+        };
+        let Ok(angles) = planar_ik(&LegGeometry::ROBOT, &pose, KneeBranch::Down) else {
+            return -1.0;
+        };
+        let limits = JointLimits::REPORT;
+        [
+            (
+                Joint::HipPitch,
+                angles.q1_rad + core::f32::consts::FRAC_PI_2,
+            ),
+            (Joint::Knee, angles.q2_rad),
+            (Joint::Ankle, angles.q3_rad),
+        ]
+        .into_iter()
+        .map(|(joint, angle)| {
+            let range = limits.range(joint);
+            (angle - range.min_rad).min(range.max_rad - angle)
+        })
+        .fold(f32::INFINITY, f32::min)
+    }
+
+    #[test]
+    fn the_schedule_keeps_every_joint_inside_its_range_where_some_pitch_does_by_8_degrees() {
+        let g = CrawlGeometry::ROBOT;
+        let (mut checked, mut worst) = (0_u32, f32::INFINITY);
+        for i in 0..13_u8 {
+            let x_m = -0.16 + 0.02 * f32::from(i);
+            for j in 0..16_u8 {
+                let depth_m = 0.22 + 0.01 * f32::from(j);
+                let best = (0..180_u8)
+                    .map(|k| margin_rad(x_m, depth_m, deg_to_rad(-180.0 + f32::from(k))))
+                    .fold(f32::NEG_INFINITY, f32::max);
+                if best < deg_to_rad(8.0) {
+                    continue;
+                }
+                let pitch_rad = g.pitch_base_rad
+                    + g.pitch_per_x_rad_m * x_m
+                    + g.pitch_per_depth_rad_m * (depth_m - g.pitch_reference_depth_m);
+                worst = worst.min(margin_rad(x_m, depth_m, pitch_rad));
+                checked += 1;
+            }
+        }
+        assert!(checked > 100, "{checked} poses");
+        assert!(worst > deg_to_rad(5.5), "{} degrees", worst.to_degrees());
     }
 }

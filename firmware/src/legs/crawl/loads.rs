@@ -6,7 +6,8 @@ use protocol::{Joints, Leg};
 use super::frame::PerLeg;
 use crate::legs::kinematics::{LegGeometry, LegJoints};
 
-/// Each foot's vertical load, N, from its leg's measured angles and the torques its hip and
+/// Each foot's load along its leg frame's z (vertical with the body level), N, from its leg's
+/// measured angles and the torques its hip and
 /// knee drives report (negative and undetermined count as none).
 pub fn foot_loads_n(
     geometry: &LegGeometry,
@@ -17,7 +18,7 @@ pub fn foot_loads_n(
         let joints = LegJoints::from_array(*measured_rad.leg(leg));
         let [_, hip_pitch_nm, knee_nm, _] = *effort_nm.leg(leg);
         crate::legs::kinematics::foot_force_n(geometry, &joints, hip_pitch_nm, knee_nm)
-            .map_or(0.0, |(_, fz_n)| fz_n.max(0.0))
+            .map_or(0.0, |force| force.fz_n.max(0.0))
     };
     PerLeg {
         fl: load(Leg::Fl),

@@ -1,6 +1,7 @@
 //! The crawl: a quasi-static free gait that moves one thing at a time, the body with all four
 //! feet down or one foot with the other three down, for ground the trot cannot take. Blind:
-//! a swinging foot finds the ground, or a riser, from the drives' encoders.
+//! a swinging foot finds the ground, or a riser, from the drives' encoders and torques, and a
+//! sway frees a foot by the loads the torques give ([`foot_loads_n`]).
 //!
 //! [`Crawl`] runs one move at a time ([`Crawl::start`]) and says how it ended
 //! ([`Outcome`]). The body and the feet live in a ground frame fixed where the crawl began
@@ -14,9 +15,11 @@
 //!
 //! Up by `lift` above where the foot stood, forward at that height, then down at a slow,
 //! steady speed until the foot stops above its target by [`CrawlConfig::touchdown_lag_m`] or
-//! its knee takes [`CrawlConfig::touchdown_knee_nm`] (it stands on something) or reaches [`CrawlConfig::search_below_m`] under where it stood
-//! ([`Outcome::NoGround`]). Carried forward, a foot that falls behind its target by
-//! [`CrawlConfig::blocked_lag_m`] has met a riser taller than the lift ([`Outcome::Blocked`]).
+//! its knee takes [`CrawlConfig::touchdown_knee_nm`] (it stands on something), or reaches
+//! [`CrawlConfig::search_below_m`] under where it stood ([`Outcome::NoGround`]). Carried forward, a foot that falls behind its target by
+//! [`CrawlConfig::blocked_lag_m`] has met a riser taller than the lift ([`Outcome::Blocked`]);
+//! a path out of the legs' reach ends in [`Outcome::OutOfReach`]. Either way the foot goes
+//! back down where it stood, from where it had got to.
 
 pub mod frame;
 mod loads;
@@ -29,7 +32,7 @@ use crate::limits::JointLimits;
 use crate::time::TickRate;
 use frame::{BodyPose, CrawlGeometry, PerLeg, Point};
 pub use loads::foot_loads_n;
-use swing::{smooth, swing_point, SwingStage};
+use swing::{smooth, swing_point, RetreatCause, SwingStage};
 
 /// Tunables of a crawl's moves.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -113,6 +116,17 @@ pub enum Move {
 pub enum Outcome {
     /// The body arrived.
     Moved,
+    /// The sway left the foot no more than [`CrawlConfig::unloaded_share`] of the weight: it
+    /// is free to lift.
+    Freed {
+        /// The foot.
+        leg: Leg,
+    },
+    /// The sway went its whole length and the foot still carries more than that share.
+    StillLoaded {
+        /// The foot.
+        leg: Leg,
+    },
     /// The foot stands on something at height `z_m` (its centre, ground frame).
     Landed {
         /// The foot.
@@ -127,6 +141,11 @@ pub enum Outcome {
     },
     /// The lowered foot found nothing within reach of the search.
     NoGround {
+        /// The foot.
+        leg: Leg,
+    },
+    /// The lift or the carry left the legs' reach: the foot went back down where it stood.
+    OutOfReach {
         /// The foot.
         leg: Leg,
     },
@@ -204,7 +223,12 @@ impl Crawl {
                 leg,
                 from: self.body,
                 direction: self.away_from(leg),
-                max_m,
+                // A length that is not a length sways nowhere.
+                max_m: if max_m.is_finite() {
+                    max_m.max(0.0)
+                } else {
+                    0.0
+                },
             },
             Move::Body { to, ms } => Running::Body {
                 from: self.body,
@@ -335,10 +359,15 @@ impl Crawl {
                 let moved_m = moved_m.min(max_m);
                 self.body.centre.x_m = from.centre.x_m + dx * moved_m;
                 self.body.centre.y_m = from.centre.y_m + dy * moved_m;
-                (unloaded || moved_m >= max_m).then(|| {
-                    self.running = Running::Idle;
-                    Outcome::Moved
-                })
+                let outcome = if unloaded {
+                    Outcome::Freed { leg }
+                } else if moved_m >= max_m {
+                    Outcome::StillLoaded { leg }
+                } else {
+                    return None;
+                };
+                self.running = Running::Idle;
+                Some(outcome)
             }
             Running::Body { from, to, ticks } => {
                 let share = self.elapsed as f32 / ticks as f32;
@@ -405,10 +434,12 @@ impl Crawl {
                 );
                 return self.end_swing(leg, last, Outcome::NoGround { leg });
             }
-            SwingStage::Lift | SwingStage::Carry if !reachable => (SwingStage::Retreat, 0, None),
+            SwingStage::Lift | SwingStage::Carry if !reachable => {
+                (retreat(target, RetreatCause::OutOfReach), 0, None)
+            }
             SwingStage::Lift if ticks >= lift_ticks => (SwingStage::Carry, 0, None),
             SwingStage::Carry if sign * (target.x_m - measured.x_m) > config.blocked_lag_m => {
-                (SwingStage::Retreat, 0, None)
+                (retreat(target, RetreatCause::Riser), 0, None)
             }
             SwingStage::Carry if ticks >= carry_ticks => (SwingStage::Lower, 0, None),
             SwingStage::Lower
@@ -429,8 +460,12 @@ impl Crawl {
             SwingStage::Lower if target.z_m <= from.z_m.min(to.z_m) - config.search_below_m => {
                 return self.end_swing(leg, target, Outcome::NoGround { leg });
             }
-            SwingStage::Retreat if ticks >= lift_ticks => {
-                return self.end_swing(leg, from, Outcome::Blocked { leg });
+            SwingStage::Retreat { cause, .. } if ticks >= lift_ticks => {
+                let outcome = match cause {
+                    RetreatCause::Riser => Outcome::Blocked { leg },
+                    RetreatCause::OutOfReach => Outcome::OutOfReach { leg },
+                };
+                return self.end_swing(leg, from, outcome);
             }
             other => (other, ticks, None),
         };
@@ -452,6 +487,11 @@ impl Crawl {
         self.running = Running::Idle;
         Some(outcome)
     }
+}
+
+/// The retreat of a swing that gave up with the foot sent to `at`.
+fn retreat(at: Point, cause: RetreatCause) -> SwingStage {
+    SwingStage::Retreat { at, cause }
 }
 
 #[cfg(test)]

@@ -12,8 +12,22 @@ pub(super) enum SwingStage {
     Lift,
     Carry,
     Lower,
-    /// Going back down where it stood after a block.
-    Retreat,
+    /// Going back down where it stood, from where the swing had got to.
+    Retreat {
+        /// Where the foot was sent when the swing gave up.
+        at: Point,
+        /// Why it gave up.
+        cause: RetreatCause,
+    },
+}
+
+/// Why a swing goes back down where it stood.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum RetreatCause {
+    /// The carried foot fell behind its target: a riser taller than the lift.
+    Riser,
+    /// The path left the legs' reach.
+    OutOfReach,
 }
 
 /// The foot's point in a swing at `stage`, `stage_ticks` in.
@@ -47,10 +61,14 @@ pub(super) fn swing_point(
             z_m: top_z_m - config.lower_m_s * stage_ticks as f32 * rate.period_s(),
             ..*to
         },
-        SwingStage::Retreat => Point {
-            z_m: top_z_m + (from.z_m - top_z_m) * share(config.lift_ms),
-            ..*from
-        },
+        SwingStage::Retreat { at, .. } => {
+            let s = share(config.lift_ms);
+            Point {
+                x_m: at.x_m + (from.x_m - at.x_m) * s,
+                y_m: at.y_m + (from.y_m - at.y_m) * s,
+                z_m: at.z_m + (from.z_m - at.z_m) * s,
+            }
+        }
     }
 }
 

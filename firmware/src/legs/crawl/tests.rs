@@ -44,8 +44,11 @@ struct Plant<'a> {
     wall: Option<(f32, f32)>,
     /// A foot that slipped along the ground: its measured x is this far off its target.
     slip: Option<(Leg, f32)>,
-    /// Each foot's vertical load, N, as its drives' torques report it.
-    loads_n: PerLeg<f32>,
+    /// Each foot's load, N, as its drives' torques report it, from the body's sideways
+    /// position and whether the ground stopped the foot (none: no load).
+    load_n: Option<&'a dyn Fn(Leg, f32, bool) -> f32>,
+    /// The crawl's configuration (none: the robot's).
+    config: Option<CrawlConfig>,
 }
 
 /// The torques a leg's drives apply to hold a vertical load `fz_n` at rest, by virtual work on
@@ -67,17 +70,22 @@ fn holding_torques_nm(geometry: &LegGeometry, joints: &LegJoints, fz_n: f32) -> 
 
 /// Runs the crawl's move on a plant whose feet follow their targets, but for the `plant`.
 fn run_on(crawl: &mut Crawl, plant: &Plant<'_>) -> Option<Outcome> {
-    let config = CrawlConfig::ROBOT;
+    let config = plant.config.unwrap_or(CrawlConfig::ROBOT);
     let geometry = LegGeometry::ROBOT;
     let limits = JointLimits::REPORT;
+    // A target out of reach holds the leg where it was, as the controller holds its goal.
+    let mut held = crawl.targets(&config, &geometry, &limits).map(|t| t.ok());
     for _ in 0..5_000_u32 {
         let targets = crawl.targets(&config, &geometry, &limits);
         let mut measured = Joints::splat(0.0);
         let mut effort = Joints::splat(0.0);
-        for (leg, target) in Leg::ALL.into_iter().zip(targets) {
-            let Ok(joints) = target else {
-                return None;
+        for ((leg, target), hold) in Leg::ALL.into_iter().zip(targets).zip(held.iter_mut()) {
+            let joints = match (target, *hold) {
+                (Ok(joints), _) => joints,
+                (Err(_), Some(joints)) => joints,
+                (Err(_), None) => return None,
             };
+            *hold = Some(joints);
             let mut foot = config
                 .geometry
                 .foot_of(&geometry, &crawl.body(), leg, &joints);
@@ -86,8 +94,11 @@ fn run_on(crawl: &mut Crawl, plant: &Plant<'_>) -> Option<Outcome> {
                     foot.x_m = wall_x_m;
                 }
             }
+            let mut grounded = false;
             if let Some(ground) = plant.ground_z_m {
-                foot.z_m = foot.z_m.max(ground(foot.x_m));
+                let ground_z_m = ground(foot.x_m);
+                grounded = foot.z_m <= ground_z_m;
+                foot.z_m = foot.z_m.max(ground_z_m);
             }
             if let Some((slipped, dx_m)) = plant.slip {
                 if slipped == leg {
@@ -99,7 +110,10 @@ fn run_on(crawl: &mut Crawl, plant: &Plant<'_>) -> Option<Outcome> {
                 .solve(&geometry, &limits, &crawl.body(), leg, &foot)
                 .unwrap_or(joints);
             *measured.leg_mut(leg) = solved.to_array();
-            *effort.leg_mut(leg) = holding_torques_nm(&geometry, &solved, plant.loads_n.get(leg));
+            let load_n = plant
+                .load_n
+                .map_or(0.0, |load| load(leg, crawl.body().centre.y_m, grounded));
+            *effort.leg_mut(leg) = holding_torques_nm(&geometry, &solved, load_n);
         }
         if let Some(outcome) = crawl.tick(&config, &geometry, &limits, &measured, &effort) {
             return Some(outcome);
@@ -174,7 +188,11 @@ fn a_swing_into_a_riser_taller_than_its_lift_is_blocked_and_goes_back_down() {
         run(&mut crawl, &|_| -1.0, wall),
         Some(Outcome::Blocked { leg: Leg::Fr })
     );
-    assert_eq!(crawl.feet().fr, start);
+    let back = crawl.feet().fr;
+    assert!(
+        (back.x_m - start.x_m).abs() < 1e-4 && back.z_m == start.z_m,
+        "{back:?}"
+    );
 }
 
 #[test]
@@ -219,35 +237,111 @@ fn a_body_move_keeps_the_feet_where_they_stand() {
 
 #[test]
 fn an_unload_sways_sideways_away_from_the_foot_until_it_carries_little() {
-    // Nothing reported: the sway goes its whole length, away from the left front foot.
+    // No torque reported: the sway goes its whole length, away from the left front foot, and
+    // says the foot is still loaded.
     let mut crawl = standing();
     crawl.start(Move::Unload {
         leg: Leg::Fl,
         max_m: 0.04,
     });
-    assert_eq!(run(&mut crawl, &|_| -1.0, None), Some(Outcome::Moved));
+    assert_eq!(
+        run(&mut crawl, &|_| -1.0, None),
+        Some(Outcome::StillLoaded { leg: Leg::Fl })
+    );
     let body = crawl.body();
     assert!((body.centre.y_m + 0.04).abs() < 1e-4, "{body:?}");
     assert!(body.centre.x_m.abs() < 1e-6, "{body:?}");
-    // The foot already carries 5 of 305 N: the sway ends at once.
+    // The back right foot sheds 3 kN per metre of sway from 100 N; the others share the rest.
+    let shed = |leg: Leg, body_y_m: f32, _: bool| {
+        let right = (100.0 - 3000.0 * body_y_m).max(0.0);
+        if leg == Leg::Br {
+            right
+        } else {
+            (400.0 - right) / 3.0
+        }
+    };
     let mut crawl = standing();
     crawl.start(Move::Unload {
         leg: Leg::Br,
-        max_m: 0.04,
+        max_m: 0.06,
     });
     let plant = Plant {
         ground_z_m: Some(&|_| -1.0),
-        loads_n: PerLeg {
-            fl: 100.0,
-            fr: 100.0,
-            bl: 100.0,
-            br: 5.0,
-        },
+        load_n: Some(&shed),
         ..Plant::default()
     };
-    assert_eq!(run_on(&mut crawl, &plant), Some(Outcome::Moved));
+    assert_eq!(
+        run_on(&mut crawl, &plant),
+        Some(Outcome::Freed { leg: Leg::Br })
+    );
+    // Freed at 40 N of 400: 2 cm of sway.
     let body = crawl.body();
-    assert!(body.centre.y_m > 0.0 && body.centre.y_m < 0.001, "{body:?}");
+    assert!((body.centre.y_m - 0.02).abs() < 0.002, "{body:?}");
+    // A length that is no length sways nowhere.
+    let mut crawl = standing();
+    crawl.start(Move::Unload {
+        leg: Leg::Br,
+        max_m: f32::NAN,
+    });
+    assert_eq!(
+        run(&mut crawl, &|_| -1.0, None),
+        Some(Outcome::StillLoaded { leg: Leg::Br })
+    );
+    assert_eq!(crawl.body(), BodyPose::default());
+}
+
+#[test]
+fn a_lowered_foot_whose_knee_takes_the_load_has_landed() {
+    // Only the knee's torque can tell: the lag rule is set out of reach.
+    let config = CrawlConfig {
+        touchdown_lag_m: 1.0,
+        ..CrawlConfig::ROBOT
+    };
+    let mut crawl = standing();
+    let start = crawl.feet().fl;
+    crawl.start(Move::Swing {
+        leg: Leg::Fl,
+        to: start,
+        lift_m: 0.03,
+    });
+    let ground_z_m = start.z_m - 0.01;
+    let plant = Plant {
+        ground_z_m: Some(&move |_| ground_z_m),
+        load_n: Some(&|_, _, grounded| if grounded { 100.0 } else { 0.0 }),
+        config: Some(config),
+        ..Plant::default()
+    };
+    let outcome = run_on(&mut crawl, &plant);
+    assert!(
+        matches!(
+            outcome,
+            Some(Outcome::Landed { leg: Leg::Fl, z_m }) if (z_m - ground_z_m).abs() < 0.005
+        ),
+        "{outcome:?}"
+    );
+}
+
+#[test]
+fn a_carry_out_of_the_legs_reach_goes_back_down_and_says_so() {
+    let mut crawl = standing();
+    let start = crawl.feet().fr;
+    crawl.start(Move::Swing {
+        leg: Leg::Fr,
+        to: Point {
+            x_m: start.x_m + 0.4,
+            ..start
+        },
+        lift_m: 0.03,
+    });
+    assert_eq!(
+        run(&mut crawl, &|_| -1.0, None),
+        Some(Outcome::OutOfReach { leg: Leg::Fr })
+    );
+    let back = crawl.feet().fr;
+    assert!(
+        (back.x_m - start.x_m).abs() < 1e-4 && back.z_m == start.z_m,
+        "{back:?}"
+    );
 }
 
 #[test]
