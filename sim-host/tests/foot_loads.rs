@@ -37,7 +37,7 @@ fn loads(plant: Plant, plan: Vec<PlanStep>, until_s: f64) -> [(f32, f32); 4] {
     let simulated = physics.foot_forces_n();
     std::array::from_fn(|i| {
         let leg = Leg::ALL[i];
-        (estimated.get(leg), simulated[i] as f32)
+        (estimated.get(leg).unwrap_or(f32::NAN), simulated[i] as f32)
     })
 }
 

@@ -7,18 +7,18 @@ use super::frame::PerLeg;
 use crate::legs::kinematics::{LegGeometry, LegJoints};
 
 /// Each foot's load along its leg frame's z (vertical with the body level), N, from its leg's
-/// measured angles and the torques its hip and
-/// knee drives report (negative and undetermined count as none).
+/// measured angles and the torques its hip and knee drives report; a pull counts as none, and
+/// a leg too nearly straight for its torques to tell is `None`.
 pub fn foot_loads_n(
     geometry: &LegGeometry,
     measured_rad: &Joints<f32>,
     effort_nm: &Joints<f32>,
-) -> PerLeg<f32> {
+) -> PerLeg<Option<f32>> {
     let load = |leg: Leg| {
         let joints = LegJoints::from_array(*measured_rad.leg(leg));
         let [_, hip_pitch_nm, knee_nm, _] = *effort_nm.leg(leg);
         crate::legs::kinematics::foot_force_n(geometry, &joints, hip_pitch_nm, knee_nm)
-            .map_or(0.0, |force| force.fz_n.max(0.0))
+            .map(|force| force.fz_n.max(0.0))
     };
     PerLeg {
         fl: load(Leg::Fl),

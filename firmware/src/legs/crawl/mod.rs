@@ -23,6 +23,7 @@
 
 pub mod frame;
 mod loads;
+pub mod preload;
 mod swing;
 
 use protocol::{Joints, Leg};
@@ -256,10 +257,11 @@ impl Crawl {
     fn away_from(&self, leg: Leg) -> (f32, f32) {
         let f = self.feet;
         let mid_y = 0.25 * (f.fl.y_m + f.fr.y_m + f.bl.y_m + f.br.y_m);
-        if f.get(leg).y_m > mid_y {
-            (0.0, -1.0)
-        } else {
-            (0.0, 1.0)
+        let side = if f.get(leg).y_m > mid_y { -1.0 } else { 1.0 };
+        match leg {
+            // Back too, toward the back feet: by half as much as sideways.
+            Leg::Fl | Leg::Fr => (-0.447, 0.894 * side),
+            Leg::Bl | Leg::Br => (0.0, side),
         }
     }
 
@@ -352,9 +354,13 @@ impl Crawl {
                 direction: (dx, dy),
                 max_m,
             } => {
+                // A leg whose load cannot be told adds nothing to the total: the share of the
+                // foot to free only comes out larger, and the sway goes on.
                 let loads = foot_loads_n(geometry, measured_rad, effort_nm);
-                let total = loads.fl + loads.fr + loads.bl + loads.br;
-                let unloaded = total > 0.0 && loads.get(leg) <= config.unloaded_share * total;
+                let total: f32 = Leg::ALL.into_iter().filter_map(|l| loads.get(l)).sum();
+                let unloaded = loads
+                    .get(leg)
+                    .is_some_and(|load| total > 0.0 && load <= config.unloaded_share * total);
                 let moved_m = config.unload_m_s * self.elapsed as f32 * self.rate.period_s();
                 let moved_m = moved_m.min(max_m);
                 self.body.centre.x_m = from.centre.x_m + dx * moved_m;
