@@ -78,6 +78,7 @@ fn the_summary_names_the_parts_of_the_robot_that_touched_an_obstacle() {
     let (plan, segments) = common::plan(&[(0.0, "stand"), (1.0, "L")]);
     let mut config = common::config(Plant::default(), plan, segments, 9.0);
     config.model = written(&scene, "summary");
+    config.scene = scene;
     let report = session::run(&config).unwrap();
     let [stand, trot] = &report.segments[..] else {
         panic!("{:?}", report.segments.len())
@@ -86,6 +87,13 @@ fn the_summary_names_the_parts_of_the_robot_that_touched_an_obstacle() {
         "MEASURED contacts with the step while trotting: {:?}",
         trot.obstacle_contacts
     );
+    // Stopped at the riser: no foot ever stood on the step.
+    let [crossing] = &trot.crossings[..] else {
+        panic!("{:?}", trot.crossings)
+    };
+    assert_eq!(crossing.obstacle, "step");
+    assert_eq!((crossing.first_foot_on_s, crossing.past_s), (None, None));
+    assert!(crossing.first_touch_s.is_some(), "{crossing:?}");
     assert!(
         stand.obstacle_contacts.is_empty(),
         "{:?}",
@@ -103,4 +111,37 @@ fn the_summary_names_the_parts_of_the_robot_that_touched_an_obstacle() {
         .iter()
         .all(|c| c.obstacle == "step" && c.cycles > 0));
     assert!(!parts.iter().any(|p| p.starts_with("foot_b")), "{parts:?}");
+}
+
+/// A trot over a 1 cm step and off its far edge 1.2 m on: the summary says when the robot first
+/// touched it, when the first foot stood on it, when all four did, when all four were past it,
+/// and how long it took (from the feet's positions and the step's profile).
+#[test]
+fn the_summary_says_when_the_robot_stood_on_an_obstacle_and_when_it_was_past_it() {
+    let scene = Scene::from_arg("step:height_m=0.01,riser_x_m=0.8").unwrap();
+    let (plan, segments) = common::plan(&[(0.0, "stand"), (1.0, "L")]);
+    let mut config = common::config(Plant::default(), plan, segments, 30.0);
+    config.model = written(&scene, "crossing");
+    config.scene = scene;
+    let report = session::run(&config).unwrap();
+    let [_, trot] = &report.segments[..] else {
+        panic!("{:?}", report.segments.len())
+    };
+    let [crossing] = &trot.crossings[..] else {
+        panic!("{:?}", trot.crossings)
+    };
+    println!("MEASURED a trot over a 1 cm step: {crossing:?}");
+    let (Some(touch), Some(first), Some(all), Some(past), Some(took)) = (
+        crossing.first_touch_s,
+        crossing.first_foot_on_s,
+        crossing.all_feet_on_s,
+        crossing.past_s,
+        crossing.crossing_s,
+    ) else {
+        panic!("not crossed: {crossing:?}")
+    };
+    assert!(touch <= first && first < all && all < past, "{crossing:?}");
+    assert!((took - (past - touch)).abs() < 1e-9, "{crossing:?}");
+    // The front feet stand 0.52 m from the riser: no foot is on the step at once.
+    assert!(first > 2.0, "{crossing:?}");
 }

@@ -60,6 +60,7 @@ impl InprocRobot {
         let stop = Arc::new(AtomicBool::new(false));
         let config = SessionConfig {
             model: options.model,
+            scene: sim_host::scene::Scene::Flat,
             bus: BusChoice::Inproc,
             clock: options.clock,
             duration_s: options.duration_s,

@@ -390,6 +390,7 @@ mod tests {
             "E-stop",
             &sim,
             Default::default(),
+            &[],
         );
         obs.segments.push(tracker.finish());
         obs

@@ -147,7 +147,7 @@ impl Watch {
         let (_, label) = scenario.segments()[0];
         Self {
             scenario,
-            current: SegmentTracker::start(label, label, rig.sim(), BusCounters::default()),
+            current: SegmentTracker::start(label, label, rig.sim(), BusCounters::default(), &[]),
             next_segment: 1,
             done: Vec::new(),
             fell_at_s: None,
@@ -168,7 +168,8 @@ impl Watch {
         if let Some(&(start_s, label)) = self.scenario.segments().get(self.next_segment) {
             // Segments change on the cycle that starts at or after their start.
             if t - PERIOD_US as f64 * 1e-6 >= start_s - 1e-9 {
-                let next = SegmentTracker::start(label, label, rig.sim(), BusCounters::default());
+                let next =
+                    SegmentTracker::start(label, label, rig.sim(), BusCounters::default(), &[]);
                 self.done
                     .push(std::mem::replace(&mut self.current, next).finish());
                 self.next_segment += 1;

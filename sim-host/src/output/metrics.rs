@@ -4,8 +4,10 @@
 
 use serde::Serialize;
 
+use crate::output::crossings::{Crossing, CrossingTracker};
 use crate::output::decimated::Decimated;
 use crate::output::torques::{TorqueFigures, TorqueTracker};
+use crate::scene::Feature;
 use crate::session::simulator::Simulator;
 
 /// A joint counts as past its limit beyond this, rad (MuJoCo's limits are soft constraints:
@@ -121,6 +123,9 @@ pub struct SegmentSummary {
     /// how many cycles, in the order first seen: a step's riser met by the feet, the shanks,
     /// the wheels or the torso.
     pub obstacle_contacts: Vec<ObstacleContact>,
+    /// For each obstacle of the scene: when a foot first stood on it, when all four did, when
+    /// all four were past it, and how long that took.
+    pub crossings: Vec<Crossing>,
 }
 
 /// A part of the robot touching an obstacle in a segment.
@@ -151,11 +156,18 @@ pub struct SegmentTracker {
     /// The geom ids of each entry of `summary.obstacle_contacts`, and the cycle it was last
     /// counted in (a pair touches at several points).
     contact_ids: Vec<((usize, usize), u64)>,
+    crossings: CrossingTracker,
 }
 
 impl SegmentTracker {
-    /// Starts a segment on the simulator's present state.
-    pub fn start(label: &str, mode: &str, sim: &Simulator, bus: BusCounters) -> Self {
+    /// Starts a segment on the simulator's present state, in a scene with `obstacles`.
+    pub fn start(
+        label: &str,
+        mode: &str,
+        sim: &Simulator,
+        bus: BusCounters,
+        obstacles: &[Feature],
+    ) -> Self {
         let config = firmware::config::Config::ROBOT;
         let limits = config
             .limits
@@ -194,6 +206,7 @@ impl SegmentTracker {
                 moved_after_1s_m: 0.0,
                 bus: BusCounters::default(),
                 obstacle_contacts: Vec::new(),
+                crossings: Vec::new(),
             },
             start_pos: torso.pos_m,
             start_yaw: yaw,
@@ -204,6 +217,7 @@ impl SegmentTracker {
             torques: TorqueTracker::start(sim),
             track: Decimated::default(),
             contact_ids: Vec::new(),
+            crossings: CrossingTracker::start(obstacles, sim),
         }
     }
 
@@ -271,6 +285,7 @@ impl SegmentTracker {
             .push((sim.time_s(), torso.pos_m[0], torso.pos_m[1], s.dyaw_deg));
         s.bus = bus.since(&self.start_bus);
         self.count_obstacle_contacts(sim);
+        self.crossings.observe(sim);
     }
 
     /// Counts this cycle's contacts with obstacles, each pair once.
@@ -305,6 +320,7 @@ impl SegmentTracker {
     /// The segment's figures.
     pub fn finish(mut self) -> SegmentSummary {
         self.summary.torques = self.torques.figures();
+        self.summary.crossings = self.crossings.finish();
         let start_s = self.summary.start_s;
         let track = std::mem::take(&mut self.track).into_vec();
         if let Some(&(_, x1, y1, _)) = track.iter().find(|(t, ..)| *t >= start_s + 1.0) {

@@ -272,6 +272,16 @@ impl Physics {
         }
     }
 
+    /// The id of the geom named `name` (`None` if the model has none).
+    pub fn geom_id(&self, name: &str) -> Option<usize> {
+        self.data.model().name_to_id(MjtObj::mjOBJ_GEOM, name)
+    }
+
+    /// Where geom `id`'s centre is, world frame, m (`None` for an id past the model's geoms).
+    pub fn geom_position_m(&self, id: usize) -> Option<[f64; 3]> {
+        self.data.geom_xpos().get(id).copied()
+    }
+
     /// Whether anything touches the geom named `name` (an obstacle of a scene: `step`,
     /// `ramp_up`, …); `false` if the model has no such geom.
     pub fn touches_geom(&self, name: &str) -> bool {

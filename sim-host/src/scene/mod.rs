@@ -163,7 +163,7 @@ impl Feature {
     }
 
     /// Ground height over x, m, inside the feature.
-    fn height_at(&self, x_m: f64) -> Option<f64> {
+    pub fn height_at(&self, x_m: f64) -> Option<f64> {
         let [x0, x1] = self.x_m;
         (x0..=x1).contains(&x_m).then(|| {
             let share = if x1 > x0 { (x_m - x0) / (x1 - x0) } else { 0.0 };

@@ -13,6 +13,7 @@ use teleop_core::scripted::PlanStep;
 
 use crate::output::telemetry::TelemetryRow;
 use crate::robot::plant::Plant;
+use crate::scene::Scene;
 
 /// Which bus the simulator joins.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -46,6 +47,9 @@ pub struct FrameSettings {
 pub struct SessionConfig {
     /// The MJCF file.
     pub model: PathBuf,
+    /// The scene the model was made for (its obstacles, for the summary's crossings; flat
+    /// for a model with none made).
+    pub scene: Scene,
     /// Bus.
     pub bus: BusChoice,
     /// Clock.

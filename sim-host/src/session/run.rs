@@ -71,7 +71,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
     let watch = Watch::open(config, &sim)?;
     let mut observer = Observer {
         config,
-        segments: Segments::new(&config.segments),
+        segments: Segments::new(&config.segments, config.scene.features()),
         progress: progress_bar(config.progress, cycles),
         watch,
         watch_error: None,

@@ -2,6 +2,7 @@
 //! time the simulated clock passes the next segment's start.
 
 use crate::output::metrics::{BusCounters, SegmentSummary, SegmentTracker};
+use crate::scene::Feature;
 use crate::session::config::SegmentSpec;
 use crate::session::simulator::Simulator;
 
@@ -9,13 +10,16 @@ use crate::session::simulator::Simulator;
 #[derive(Debug)]
 pub(crate) struct Segments {
     specs: Vec<SegmentSpec>,
+    /// The scene's obstacles, for each segment's crossings.
+    obstacles: Vec<Feature>,
     done: Vec<SegmentSummary>,
     current: Option<(usize, SegmentTracker)>,
 }
 
 impl Segments {
-    /// Segments starting where `specs` say (none: the whole run is one segment, `run`).
-    pub(crate) fn new(specs: &[SegmentSpec]) -> Self {
+    /// Segments starting where `specs` say (none: the whole run is one segment, `run`), in a
+    /// scene with `obstacles`.
+    pub(crate) fn new(specs: &[SegmentSpec], obstacles: Vec<Feature>) -> Self {
         let specs = if specs.is_empty() {
             vec![SegmentSpec {
                 start_s: 0.0,
@@ -27,6 +31,7 @@ impl Segments {
         };
         Self {
             specs,
+            obstacles,
             done: Vec::new(),
             current: None,
         }
@@ -46,7 +51,8 @@ impl Segments {
                     self.done.push(done.finish());
                 }
                 let spec = &self.specs[due];
-                let mut fresh = SegmentTracker::start(&spec.label, &spec.mode, sim, counters);
+                let mut fresh =
+                    SegmentTracker::start(&spec.label, &spec.mode, sim, counters, &self.obstacles);
                 fresh.observe(sim, counters);
                 self.current = Some((due, fresh));
             }

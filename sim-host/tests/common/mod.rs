@@ -29,6 +29,7 @@ pub fn config(
         attach: None,
         faults: Default::default(),
         model: PathBuf::from(DEFAULT_MODEL),
+        scene: sim_host::scene::Scene::Flat,
         bus: BusChoice::Inproc,
         clock: Clock::Lockstep,
         duration_s,

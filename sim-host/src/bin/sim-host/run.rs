@@ -283,7 +283,8 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
         ));
     }
     let model = model_path(&args, scenario_scene)?;
-    let config = session_config(&args, scenario.as_ref(), duration_s, model);
+    let mut config = session_config(&args, scenario.as_ref(), duration_s, model);
+    config.scene = made_scene(&args, scenario_scene);
     tracing::info!(model = %config.model.display(), bus = %args.bus, "starting");
     let report = session::run(&config).map_err(|e| match e {
         session::SessionError::Bus(bus) if bus.is_missing_interface() => {
@@ -314,6 +315,15 @@ fn model_path(args: &RunArgs, from_scenario: Option<Scene>) -> Result<PathBuf, S
     }
 }
 
+/// The scene made from parameters (`--scene`, else the scenario's), whose obstacles the summary
+/// judges crossings against; flat for the shipped obstacles file, whose parts it does not know.
+fn made_scene(args: &RunArgs, from_scenario: Option<Scene>) -> Scene {
+    match args.scene.or(from_scenario.map(SceneArg::Made)) {
+        Some(SceneArg::Made(scene)) => scene,
+        None | Some(SceneArg::Obstacles) => Scene::Flat,
+    }
+}
+
 /// The session `args` (and the scenario, if one was given) describe.
 fn session_config(
     args: &RunArgs,
@@ -341,6 +351,7 @@ fn session_config(
     };
     SessionConfig {
         model,
+        scene: Scene::Flat,
         bus,
         clock: match args.clock {
             ClockArg::Lockstep => Clock::Lockstep,
