@@ -7,6 +7,7 @@ mod common;
 use std::path::{Path, PathBuf};
 
 use mujoco_rs::prelude::{MjData, MjModel};
+use sim_host::output::metrics::SegmentSummary;
 use sim_host::robot::model::DEFAULT_MODEL;
 use sim_host::robot::physics::Physics;
 use sim_host::robot::plant::Plant;
@@ -72,17 +73,25 @@ fn a_scenario_names_its_scene_and_sim_host_builds_it() {
     assert_eq!(scene.ground_height_m(2.0), 0.12);
 }
 
-#[test]
-fn the_summary_names_the_parts_of_the_robot_that_touched_an_obstacle() {
-    let scene = Scene::from_arg("step:height_m=0.10,riser_x_m=0.6").unwrap();
+/// The robot as drawn stands, then trots (L at 1 s) for `duration_s` in the scene `arg`
+/// (written under `name`): the two segments' figures.
+fn stand_and_trot(arg: &str, name: &str, duration_s: f64) -> [SegmentSummary; 2] {
+    let scene = Scene::from_arg(arg).unwrap();
     let (plan, segments) = common::plan(&[(0.0, "stand"), (1.0, "L")]);
-    let mut config = common::config(Plant::default(), plan, segments, 9.0);
-    config.model = written(&scene, "summary");
+    let mut config = common::config(Plant::default(), plan, segments, duration_s);
+    config.model = written(&scene, name);
     config.scene = scene;
     let report = session::run(&config).unwrap();
-    let [stand, trot] = &report.segments[..] else {
-        panic!("{:?}", report.segments.len())
-    };
+    let count = report.segments.len();
+    report
+        .segments
+        .try_into()
+        .unwrap_or_else(|_| panic!("{count} segments"))
+}
+
+#[test]
+fn the_summary_names_the_parts_of_the_robot_that_touched_an_obstacle() {
+    let [stand, trot] = stand_and_trot("step:height_m=0.10,riser_x_m=0.6", "summary", 9.0);
     println!(
         "MEASURED contacts with the step while trotting: {:?}",
         trot.obstacle_contacts
@@ -118,15 +127,7 @@ fn the_summary_names_the_parts_of_the_robot_that_touched_an_obstacle() {
 /// and how long it took (from the feet's positions and the step's profile).
 #[test]
 fn the_summary_says_when_the_robot_stood_on_an_obstacle_and_when_it_was_past_it() {
-    let scene = Scene::from_arg("step:height_m=0.01,riser_x_m=0.8").unwrap();
-    let (plan, segments) = common::plan(&[(0.0, "stand"), (1.0, "L")]);
-    let mut config = common::config(Plant::default(), plan, segments, 30.0);
-    config.model = written(&scene, "crossing");
-    config.scene = scene;
-    let report = session::run(&config).unwrap();
-    let [_, trot] = &report.segments[..] else {
-        panic!("{:?}", report.segments.len())
-    };
+    let [_, trot] = stand_and_trot("step:height_m=0.01,riser_x_m=0.8", "crossing", 30.0);
     let [crossing] = &trot.crossings[..] else {
         panic!("{:?}", trot.crossings)
     };

@@ -70,6 +70,16 @@ impl<T: Copy> PerLeg<T> {
         }
     }
 
+    /// `f` of each leg.
+    pub fn from_fn(mut f: impl FnMut(Leg) -> T) -> Self {
+        Self {
+            fl: f(Leg::Fl),
+            fr: f(Leg::Fr),
+            bl: f(Leg::Bl),
+            br: f(Leg::Br),
+        }
+    }
+
     /// `leg`'s value.
     pub fn get(&self, leg: Leg) -> T {
         match leg {

@@ -20,10 +20,5 @@ pub fn foot_loads_n(
         crate::legs::kinematics::foot_force_n(geometry, &joints, hip_pitch_nm, knee_nm)
             .map(|force| force.fz_n.max(0.0))
     };
-    PerLeg {
-        fl: load(Leg::Fl),
-        fr: load(Leg::Fr),
-        bl: load(Leg::Bl),
-        br: load(Leg::Br),
-    }
+    PerLeg::from_fn(load)
 }

@@ -244,6 +244,11 @@ impl Crawl {
         outcome
     }
 
+    /// How far the sway under way has gone, m: at the sway's speed, at most `max_m`.
+    fn swayed_m(&self, config: &CrawlConfig, max_m: f32) -> f32 {
+        (config.unload_m_s * self.elapsed as f32 * self.rate.period_s()).min(max_m)
+    }
+
     /// Takes every foot's position along the ground from where the encoders put it, its
     /// height from its target. A foot that slipped, or a leg pushed off its target along the
     /// ground by the others, would otherwise leave the legs pushing against each other with
@@ -291,8 +296,7 @@ impl Crawl {
                 let unloaded = loads
                     .get(leg)
                     .is_some_and(|load| total > 0.0 && load <= config.unloaded_share * total);
-                let moved_m = config.unload_m_s * self.elapsed as f32 * self.rate.period_s();
-                let moved_m = moved_m.min(max_m);
+                let moved_m = self.swayed_m(config, max_m);
                 self.body.centre.x_m = from.centre.x_m + dx * moved_m;
                 self.body.centre.y_m = from.centre.y_m + dy * moved_m;
                 let outcome = if unloaded {

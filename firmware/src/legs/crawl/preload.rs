@@ -24,10 +24,10 @@ impl Crawl {
         // three as the sway goes on.
         let (lifted, handed) = match self.running {
             Running::Swing { leg, .. } => (Some(leg), 1.0),
-            Running::Unload { leg, max_m, .. } if max_m > 0.0 => {
-                let moved_m = config.unload_m_s * self.elapsed as f32 * self.rate.period_s();
-                (Some(leg), crate::math::clamp(moved_m / max_m, 0.0, 1.0))
-            }
+            Running::Unload { leg, max_m, .. } if max_m > 0.0 => (
+                Some(leg),
+                crate::math::clamp(self.swayed_m(config, max_m) / max_m, 0.0, 1.0),
+            ),
             _ => (None, 0.0),
         };
         let centre = self.body.centre;
@@ -42,21 +42,15 @@ impl Crawl {
             None => four,
         };
         let blend = |leg: Leg| four.get(leg) + (three.get(leg) - four.get(leg)) * handed;
-        let loads = PerLeg {
-            fl: blend(Leg::Fl),
-            fr: blend(Leg::Fr),
-            bl: blend(Leg::Bl),
-            br: blend(Leg::Br),
-        };
-        let targets = self.targets(config, geometry, limits);
-        let mut out = targets;
-        for ((leg, target), slot) in Leg::ALL.into_iter().zip(targets).zip(out.iter_mut()) {
+        let loads = PerLeg::from_fn(blend);
+        let mut targets = self.targets(config, geometry, limits);
+        for (leg, target) in Leg::ALL.into_iter().zip(targets.iter_mut()) {
             if let Ok(joints) = target {
-                let torques = holding_torques_nm(geometry, &joints, loads.get(leg));
-                *slot = Ok(led(&joints, &torques, kp_nm_rad));
+                let torques = holding_torques_nm(geometry, joints, loads.get(leg));
+                *joints = led(joints, &torques, kp_nm_rad);
             }
         }
-        out
+        targets
     }
 }
 
@@ -97,12 +91,7 @@ pub fn planned_loads_n(
         let [l0, l1, l2] = lambda;
         (r0 * l0 + r1 * l1 + r2 * l2).max(0.0)
     };
-    PerLeg {
-        fl: load(Leg::Fl),
-        fr: load(Leg::Fr),
-        bl: load(Leg::Bl),
-        br: load(Leg::Br),
-    }
+    PerLeg::from_fn(load)
 }
 
 /// The torques a leg's drives apply to hold `fz_n` up at the foot, N·m, wire order: by

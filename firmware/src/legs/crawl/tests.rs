@@ -24,15 +24,7 @@ fn standing_at(depth_m: f32) -> Crawl {
             ..hip
         }
     };
-    Crawl::new(
-        RATE,
-        PerLeg {
-            fl: under(Leg::Fl),
-            fr: under(Leg::Fr),
-            bl: under(Leg::Bl),
-            br: under(Leg::Br),
-        },
-    )
+    Crawl::new(RATE, PerLeg::from_fn(under))
 }
 
 /// What the test plant does besides following the targets.
@@ -49,23 +41,6 @@ struct Plant<'a> {
     load_n: Option<&'a dyn Fn(Leg, f32, bool) -> f32>,
     /// The crawl's configuration (none: the robot's).
     config: Option<CrawlConfig>,
-}
-
-/// The torques a leg's drives apply to hold a vertical load `fz_n` at rest, by virtual work on
-/// the leg's FK (independently of [`crate::legs::kinematics::foot_force_n`]).
-fn holding_torques_nm(geometry: &LegGeometry, joints: &LegJoints, fz_n: f32) -> [f32; 4] {
-    let step = 1e-3_f32;
-    let dz = |bump: fn(&mut LegJoints, f32)| {
-        let (mut plus, mut minus) = (*joints, *joints);
-        bump(&mut plus, step);
-        bump(&mut minus, -step);
-        let a = crate::legs::kinematics::leg_fk(geometry, &plus).z_m;
-        let b = crate::legs::kinematics::leg_fk(geometry, &minus).z_m;
-        (a - b) / (2.0 * step)
-    };
-    let hip = -dz(|j, d| j.hip_pitch_rad += d) * fz_n;
-    let knee = -dz(|j, d| j.knee_rad += d) * fz_n;
-    [0.0, hip, knee, 0.0]
 }
 
 /// Runs the crawl's move on a plant whose feet follow their targets, but for the `plant`.
@@ -113,7 +88,7 @@ fn run_on(crawl: &mut Crawl, plant: &Plant<'_>) -> Option<Outcome> {
             let load_n = plant
                 .load_n
                 .map_or(0.0, |load| load(leg, crawl.body().centre.y_m, grounded));
-            *effort.leg_mut(leg) = holding_torques_nm(&geometry, &solved, load_n);
+            *effort.leg_mut(leg) = preload::holding_torques_nm(&geometry, &solved, load_n);
         }
         if let Some(outcome) = crawl.tick(&config, &geometry, &limits, &measured, &effort) {
             return Some(outcome);
