@@ -53,6 +53,8 @@ fn operator(mode: TeleopMode) -> [AnyMessage; 2] {
             mode,
             body_height: BodyHeight::saturating_from_si(0.0),
             speed_scale: SpeedScale::from_raw(100).unwrap(),
+            speed: Default::default(),
+            yaw_rate: Default::default(),
         }),
     ]
 }

@@ -1,6 +1,7 @@
 //! Every tunable of the controller in one value, with the report's numbers as defaults.
 
 use crate::control::estimator::EstimatorConfig;
+use crate::control::steering::SteeringConfig;
 use crate::control::stop::StopConfig;
 use crate::legs::blocked::BlockedConfig;
 use crate::legs::gait::TrotParams;
@@ -48,6 +49,8 @@ pub struct Config {
     pub pose_tolerance_rad: f32,
     /// Wheel speed of W/S and of each wheel in A (the report's 4 rad/s).
     pub wheel_speed_rad_s: f32,
+    /// Steering: the wheel track and the yaw-rate limits.
+    pub steering: SteeringConfig,
     /// Per-wheel torque limit, N·m.
     pub wheel_torque_limit_nm: f32,
     /// Turn (differential) speed loop.
@@ -108,6 +111,7 @@ impl Config {
         transfer: TransferConfig::ROBOT,
         pose_tolerance_rad: 0.01,
         wheel_speed_rad_s: 4.0,
+        steering: SteeringConfig::ROBOT,
         wheel_torque_limit_nm: WHEEL_TORQUE_LIMIT_NM,
         turn: SpeedLoopGains::TURN,
         balance: BalanceConfig {

@@ -284,6 +284,8 @@ fn any_message() -> impl Strategy<Value = AnyMessage> {
                 mode,
                 body_height: BodyHeight::saturating_from_si(h),
                 speed_scale: SpeedScale::from_raw(s).unwrap(),
+                speed: Default::default(),
+                yaw_rate: Default::default(),
             }
         )),
         Just(AnyMessage::TeleopHeartbeat(TeleopHeartbeat {

@@ -20,7 +20,7 @@ fn targets(trot: &Trot, direction: Direction, depth_m: f32) -> [LegJoints; 4] {
     trot.targets(
         direction,
         depth_m,
-        1.0,
+        &firmware::legs::gait::TrotCommand::straight(1.0),
         &Attitude::default(),
         &CONFIG.geometry,
         &CONFIG.limits,
@@ -200,7 +200,7 @@ fn every_gait_pose_solves_across_the_body_height_band_and_speed_scales() {
                 for (leg, result) in Leg::ALL.iter().zip(trot.targets(
                     Direction::Forward,
                     depth,
-                    scale,
+                    &firmware::legs::gait::TrotCommand::straight(scale),
                     &attitude,
                     &CONFIG.geometry,
                     &CONFIG.limits,
@@ -245,5 +245,62 @@ fn a_swing_is_counted_from_lift_off_in_both_directions() {
             first.is_some_and(|f: f32| f < 0.05),
             "{direction:?}: starts at {first:?}"
         );
+    }
+}
+
+/// A yaw rate strides each foot along its hip's path: turning left, the right feet stride
+/// longer than the left, the front feet stride to the right and the back feet to the left
+/// (seen from the body: the body turns left over them). Walking backward the same turn
+/// reverses every stride's sense with the phase. No stride exceeds the full one, and shrinking
+/// them keeps their proportions (the turn's radius).
+#[test]
+fn a_turning_trot_strides_each_foot_along_its_hips_path() {
+    use firmware::legs::gait::TrotCommand;
+    let trot = Trot::new(TrotParams::DEFAULT, TickRate::SIM_250_HZ).unwrap();
+    let full_m_s = trot.full_speed_m_s().unwrap();
+    assert!((full_m_s - 0.08 / 0.55).abs() < 1e-5, "{full_m_s}");
+    let straight = trot.strides(Direction::Forward, &TrotCommand::straight(0.5));
+    assert!(straight.iter().all(|s| s.along == 0.5 && s.across == 0.0));
+    let left = TrotCommand {
+        stride_share: 0.5,
+        yaw_rate_rad_s: 0.2,
+    };
+    let [fl, fr, bl, br] = trot.strides(Direction::Forward, &left);
+    // ω·y / v_full = 0.2 · 0.15 / 0.1455 ≈ 0.206; ω·x / v_full ≈ 0.302.
+    assert!((fr.along - 0.706).abs() < 0.002 && (fl.along - 0.294).abs() < 0.002);
+    assert_eq!((bl.along, br.along), (fl.along, fr.along));
+    assert!((fl.across - 0.302).abs() < 0.002 && fl.across == fr.across);
+    assert!(bl.across == -fl.across && br.across == bl.across);
+    let [bfl, _, _, bbr] = trot.strides(Direction::Backward, &left);
+    assert!((bfl.along - 0.706).abs() < 0.002 && (bbr.along - 0.294).abs() < 0.002);
+    assert!(bfl.across == -fl.across);
+    let fast = TrotCommand {
+        stride_share: 1.0,
+        yaw_rate_rad_s: 0.4,
+    };
+    let strides = trot.strides(Direction::Forward, &fast);
+    let longest = strides
+        .iter()
+        .map(|s| s.along.hypot(s.across))
+        .fold(0.0_f32, f32::max);
+    assert!((longest - 1.0).abs() < 1e-5, "{longest}");
+    let [sfl, sfr, ..] = strides;
+    // Unshrunk: 1 − 0.412 and 1 + 0.412; the ratio holds after shrinking.
+    assert!((sfl.along / sfr.along - 0.588 / 1.412).abs() < 1e-3);
+    // Every turning pose solves.
+    let mut turning = trot;
+    for _ in 0..250 {
+        for result in turning.targets(
+            Direction::Forward,
+            CONFIG.posture.depth_nominal_m,
+            &fast,
+            &Attitude::default(),
+            &CONFIG.geometry,
+            &CONFIG.limits,
+            &CONFIG.posture,
+        ) {
+            assert!(result.is_ok(), "{result:?}");
+        }
+        turning.advance();
     }
 }

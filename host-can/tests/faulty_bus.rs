@@ -23,6 +23,8 @@ fn command(counter: u32) -> Frame {
         mode: TeleopMode::TrotForward,
         body_height: BodyHeight::saturating_from_si(0.0),
         speed_scale: SpeedScale::saturating_from_si(1.0),
+        speed: Default::default(),
+        yaw_rate: Default::default(),
     })
     .encode(&SESSION, counter)
     .unwrap()

@@ -57,6 +57,8 @@
 //!     mode: TeleopMode::WheelForward,
 //!     body_height: BodyHeight::from_si(0.05).unwrap(),
 //!     speed_scale: SpeedScale::from_si(80.0).unwrap(),
+//!     speed: Default::default(),
+//!     yaw_rate: Default::default(),
 //! };
 //! let mut teleop_tx = Sender::new();
 //! let frame = teleop_tx

@@ -48,6 +48,18 @@ wire_scalar!(
     SpeedScale(u8) = U8, exp10 0, unit "%", raw 0, 100
 );
 wire_scalar!(
+    /// Commanded ground speed of the body, + forward. 1e-3 m/s, `i16`, accepted −2000…2000
+    /// (±2 m/s: past what the robot reaches on the wheels; the controller clamps to its own
+    /// limits).
+    GroundSpeed(i16) = I16, exp10 -3, unit "m/s", raw -2_000, 2_000
+);
+wire_scalar!(
+    /// Commanded yaw rate of the body, + turning left (counter-clockwise seen from above).
+    /// 1e-3 rad/s, `i16`, accepted −3000…3000 (±3 rad/s; the controller clamps to its own
+    /// limits).
+    YawRate(i16) = I16, exp10 -3, unit "rad/s", raw -3_000, 3_000
+);
+wire_scalar!(
     /// Control tick count. 1 tick, `u32`; wraps after 2^32 ticks (49.7 days at 1 kHz).
     Tick(u32) = U32, exp10 0, unit "tick", raw 0, u32::MAX
 );
@@ -180,6 +192,10 @@ wire_enum!(
         Stand = 6 => "Stand",
         /// Fold the legs and balance on the wheels.
         Fold = 7 => "Fold",
+        /// Balance on the wheels at the command's `speed` and `yaw_rate` (a gamepad's sticks).
+        Drive = 8 => "Drive",
+        /// Trot at the command's `speed` and `yaw_rate`.
+        Walk = 9 => "Walk",
     }
 );
 
@@ -206,6 +222,10 @@ wire_enum!(
         EStop = 8 => "EStop",
         /// A fault stopped the robot.
         Fault = 9 => "Fault",
+        /// Balancing on the wheels at the operator's speed and yaw rate.
+        Driving = 10 => "Driving",
+        /// Trotting at the operator's speed and yaw rate.
+        Walking = 11 => "Walking",
     }
 );
 

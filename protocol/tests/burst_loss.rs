@@ -96,6 +96,8 @@ fn a_gap_of_40_000_lost_frames_is_recovered() {
         mode: TeleopMode::WheelForward,
         body_height: BodyHeight::default(),
         speed_scale: SpeedScale::from_raw(50).unwrap(),
+        speed: Default::default(),
+        yaw_rate: Default::default(),
     });
     // Each sender sends one frame a millisecond: the controller's wheel command (CRC) to the
     // drive, the drive's feedback (CRC) and the teleop's command (CMAC) to the controller. The

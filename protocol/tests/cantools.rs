@@ -104,6 +104,8 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
                 BodyHeight::STEP,
             );
             put("speed_scale".into(), f64::from(m.speed_scale.si()), 1.0);
+            put("speed".into(), f64::from(m.speed.si()), GroundSpeed::STEP);
+            put("yaw_rate".into(), f64::from(m.yaw_rate.si()), YawRate::STEP);
         }
         AnyMessage::TeleopHeartbeat(m) => put("uptime".into(), f64::from(m.uptime.raw()), 1.0),
         AnyMessage::ControllerStatus(m) => {

@@ -148,15 +148,16 @@ fn a_flipped_bit_anywhere_in_a_crc_frame_fails_the_crc() {
 #[test]
 fn a_frame_moved_to_another_id_of_the_same_length_fails_its_check() {
     let mut rx = controller();
-    let frame = teleop_frame(0);
+    // A heartbeat (uptime 0: its first payload byte is not the latch's action) moved onto the
+    // E-stop's identifier would read as a release: its check covers the data id, so it fails.
+    let heartbeat = TeleopHeartbeat {
+        uptime: Millis::from_raw(0).unwrap(),
+    };
+    let frame = encode(&heartbeat, (), &controller_session(), 0).unwrap();
+    assert_eq!(MessageId::EStop.layout().wire_len, frame.data().len());
     assert_eq!(
-        MessageId::TeleopHeartbeat.layout().wire_len,
-        frame.data().len()
-    );
-    // The data id differs.
-    assert_eq!(
-        rx.receive(MessageId::TeleopHeartbeat.raw(), frame.data()),
-        Err(DecodeError::Unauthentic { id: 0x201 })
+        rx.receive(MessageId::EStop.raw(), frame.data()),
+        Err(DecodeError::Unauthentic { id: 0x000 })
     );
     only_cause(&rx, RejectCause::Unauthentic);
 }

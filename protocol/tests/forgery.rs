@@ -43,6 +43,8 @@ fn authenticated_messages() -> Vec<(AnyMessage, fn() -> Receiver)> {
             mode: TeleopMode::TrotForward,
             body_height: BodyHeight::default(),
             speed_scale: SpeedScale::from_raw(100).unwrap(),
+            speed: Default::default(),
+            yaw_rate: Default::default(),
         }),
         AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
             uptime: Millis::from_raw(99).unwrap(),

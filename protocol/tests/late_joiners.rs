@@ -120,6 +120,8 @@ fn a_freshly_joined_member_refuses_a_replay_from_beyond_its_search() {
             mode: TeleopMode::WheelForward,
             body_height: BodyHeight::default(),
             speed_scale: SpeedScale::from_raw(40).unwrap(),
+            speed: Default::default(),
+            yaw_rate: Default::default(),
         })
         .encode(&Session::owned(TEST_KEY, OLD), counter)
         .unwrap()
@@ -189,6 +191,8 @@ fn a_teleop_joining_just_below_a_period_boundary_is_taken_from_its_first_frame()
         mode: TeleopMode::WheelForward,
         body_height: BodyHeight::default(),
         speed_scale: SpeedScale::from_raw(50).unwrap(),
+        speed: Default::default(),
+        yaw_rate: Default::default(),
     });
     for (message, status) in [
         (heartbeat(1), E2eStatus::Initial),

@@ -58,6 +58,8 @@ fn closed_loop(c: &mut Criterion) {
         mode: TeleopMode::WheelForward,
         body_height_m: 0.0,
         speed_scale_pct: 100.0,
+        speed_m_s: 0.0,
+        yaw_rate_rad_s: 0.0,
     }]);
     let mut recorder = Recorder::discarding();
     let options = LockstepOptions {

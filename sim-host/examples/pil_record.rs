@@ -43,6 +43,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         mode,
         body_height_m: 0.0,
         speed_scale_pct: 100.0,
+        speed_m_s: 0.0,
+        yaw_rate_rad_s: 0.0,
     };
     let plan = vec![
         step(0.0, TeleopMode::Stand),

@@ -237,6 +237,8 @@ fn body_height_commands_are_held_within_1_cm_where_the_legs_reach() {
             mode: protocol::TeleopMode::Stand,
             body_height_m: offset_m,
             speed_scale_pct: 100.0,
+            speed_m_s: 0.0,
+            yaw_rate_rad_s: 0.0,
         }];
         let report = session::run(&config(Plant::default(), plan, Vec::new(), 3.0)).unwrap();
         let s = &report.segments[0];

@@ -51,6 +51,8 @@ fn run(w_s: f64) -> Vec<Row> {
         mode,
         body_height_m: 0.0,
         speed_scale_pct: 100.0,
+        speed_m_s: 0.0,
+        yaw_rate_rad_s: 0.0,
     };
     let mut teleop = ScriptedTeleop::new(vec![
         step(0.0, TeleopMode::Fold),

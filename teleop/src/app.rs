@@ -187,6 +187,8 @@ pub fn mode_text(mode: protocol::TeleopMode) -> &'static str {
         M::TrotBackward => "K trot backward",
         M::Stand => "T stand on the legs",
         M::Fold => "F fold onto the wheels",
+        M::Drive => "drive on the wheels at the sticks' speed and yaw rate",
+        M::Walk => "walk on the legs at the sticks' speed and yaw rate",
     }
 }
 
@@ -196,6 +198,8 @@ fn describe(key: Key) -> String {
         Key::Char(c) => format!("`{c}`"),
         Key::Up => "↑".into(),
         Key::Down => "↓".into(),
+        Key::Left => "←".into(),
+        Key::Right => "→".into(),
         Key::Esc => "Esc".into(),
     }
 }

@@ -139,6 +139,8 @@ pub fn key_of(event: Event) -> Option<Key> {
         KeyCode::Char(c) => Some(Key::Char(c)),
         KeyCode::Up => Some(Key::Up),
         KeyCode::Down => Some(Key::Down),
+        KeyCode::Left => Some(Key::Left),
+        KeyCode::Right => Some(Key::Right),
         KeyCode::Esc => Some(Key::Esc),
         _ => None,
     }

@@ -14,7 +14,7 @@ use crate::app::{mode_text, App};
 
 /// The keys, as the help line shows them.
 pub const KEY_HELP: &str = "W/S wheels fwd/back · A rotate · L/K trot fwd/back · X stop · \
-T stand · F fold · ↑/↓ height · ]/[ speed · space E-STOP · R R release · Q quit";
+T stand · F fold · ←/→ steer · ↑/↓ height · ]/[ speed · space E-STOP · R R release · Q quit";
 
 /// Draws the whole screen for time `now_ms`.
 pub fn draw(frame: &mut Frame, app: &App, now_ms: u64) {
@@ -131,10 +131,11 @@ fn draw_command(frame: &mut Frame, area: Rect, app: &App, now_ms: u64) {
         .map_or("not yet sent".to_owned(), |ms| format!("sent {ms} ms ago"));
     let lines = vec![
         Line::from(format!(
-            "command {}   height {:+.2} m   speed {:.0} %",
+            "command {}   height {:+.2} m   speed {:.0} %   steer {:+.2} rad/s",
             mode_text(op.mode()),
             op.body_height_m(),
-            op.speed_scale_pct()
+            op.speed_scale_pct(),
+            op.yaw_rate_rad_s()
         )),
         Line::from(format!(
             "heartbeat {heartbeat} (50 Hz)   frames sent {}",

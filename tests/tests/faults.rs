@@ -177,6 +177,8 @@ fn teleop_command(mode: TeleopMode) -> AnyMessage {
         mode,
         body_height: BodyHeight::saturating_from_si(0.0),
         speed_scale: SpeedScale::saturating_from_si(1.0),
+        speed: Default::default(),
+        yaw_rate: Default::default(),
     })
 }
 

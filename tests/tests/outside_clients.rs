@@ -227,6 +227,8 @@ fn a_teleop_command_from_cansend_folds_the_robot_onto_its_wheels() {
             mode,
             body_height: protocol::BodyHeight::saturating_from_si(0.0),
             speed_scale: protocol::SpeedScale::saturating_from_si(100.0),
+            speed: Default::default(),
+            yaw_rate: Default::default(),
         })
     };
     let mut tool = protocol::Sender::new();

@@ -152,6 +152,8 @@ fn parse(args: &[String]) -> Result<Request, String> {
                 .ok_or_else(|| format!("--height-m {height_m} is outside −0.10…0.12 m"))?,
             speed_scale: SpeedScale::from_si(speed_pct)
                 .ok_or_else(|| format!("--speed-pct {speed_pct} is outside 0…100"))?,
+            speed: Default::default(),
+            yaw_rate: Default::default(),
         }),
         other => return Err(format!("unknown frame `{other}`\n{USAGE}")),
     };

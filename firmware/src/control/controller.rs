@@ -17,6 +17,8 @@ mod folding;
 mod status;
 mod stopping;
 mod supervise;
+mod walking;
+mod wheel_law;
 
 use protocol::{AnyMessage, DriveFlags, EStopAction, FaultFlags, Joints, Leg, PerDrive};
 
@@ -36,9 +38,9 @@ use crate::legs::smoothing::Smoother;
 use crate::legs::support::LegStance;
 use crate::legs::transfer::Transfer;
 use crate::time::Tick;
-use crate::wheels::balance::{Balance, BalanceInput};
-use crate::wheels::runaway::{Runaway, RunawayInput};
-use crate::wheels::wheel::{mix, SpeedLoop};
+use crate::wheels::balance::Balance;
+use crate::wheels::runaway::Runaway;
+use crate::wheels::wheel::SpeedLoop;
 
 /// How fast the turn reference changes, rad/s² of wheel rate: a step to the turn's full
 /// rate asked the turn loop for its whole torque at once, and on low friction the wheels slipped
@@ -117,6 +119,8 @@ pub struct Controller {
     blocked_swings: BlockedSwings,
     /// Whether a blocked trot stopped the robot: reported until the operator's next request.
     leg_blocked: bool,
+    /// Which way `Walk` trots (see [`Controller::follow_walk_direction`]).
+    walk_direction: Direction,
 }
 
 impl Controller {
@@ -163,6 +167,7 @@ impl Controller {
             last_ground_m_s: None,
             blocked_swings: BlockedSwings::new(),
             leg_blocked: false,
+            walk_direction: Direction::Forward,
         })
     }
 
@@ -259,19 +264,20 @@ impl Controller {
             }
             State::Fault if self.stop.is_some() => legs_enabled &= self.run_stop(now),
             State::Hold | State::Fault => {}
-            State::Standing(motion) if self.unsettled() => {
+            State::Standing(_) if self.unsettled() => {
                 // Settle on the wheels first (`unsettled`): legs that unfold under a rolling
                 // robot lift it off its wheels with its momentum in it (driving at 0.48 m/s,
                 // standing up flipped it over). The goal is set, so the transition is not
                 // taken as done, but the legs wait, or go to the fold a stand-up starts
                 // from (`Levelling::stow`).
-                self.leg_goal(motion, depth_m);
+                self.leg_goal(depth_m);
                 self.stow_legs();
             }
-            State::Legs(motion) | State::Standing(motion) => {
-                self.leg_goal(motion, depth_m);
+            State::Legs(_) | State::Standing(_) => {
+                self.follow_walk_direction();
+                self.leg_goal(depth_m);
                 let rate = match self.state {
-                    State::Legs(LegMotion::Trot(_)) => self.config.gait_rate_per_s,
+                    State::Legs(motion) if motion.trotting() => self.config.gait_rate_per_s,
                     _ => self.config.leg_rate_per_s,
                 };
                 self.smooth(rate);
@@ -285,7 +291,7 @@ impl Controller {
         let mut wheel_torque_nm = self.wheel_torques(now, dt_s);
         self.level(dt_s);
         self.watch_swings();
-        if matches!(self.state, State::Legs(LegMotion::Trot(_))) {
+        if matches!(self.state, State::Legs(motion) if motion.trotting()) {
             self.trot.advance();
         }
         let mut leg_targets_rad = self.legs_rad;
@@ -342,9 +348,12 @@ impl Controller {
         if next == self.state {
             return;
         }
-        let entering_trot = matches!(next, State::Legs(LegMotion::Trot(_)))
-            && !matches!(self.state, State::Legs(LegMotion::Trot(_)));
-        if matches!(next, State::Legs(LegMotion::Trot(_))) {
+        let trotting = |state: State| matches!(state, State::Legs(motion) if motion.trotting());
+        let entering_trot = trotting(next) && !trotting(self.state);
+        if next == State::Legs(LegMotion::Walk) && self.state != next {
+            self.walk_direction = Direction::Forward;
+        }
+        if trotting(next) {
             // Counted afresh for every trot and every change of its direction.
             self.blocked_swings.reset();
         }
@@ -384,10 +393,7 @@ impl Controller {
             self.fold_return = None;
             self.fold_done_at = None;
         }
-        let moving_on_wheels = matches!(
-            self.state,
-            State::Wheels(WheelMotion::Drive(_) | WheelMotion::Rotate)
-        );
+        let moving_on_wheels = matches!(self.state, State::Wheels(motion) if motion.moving());
         self.stopped_on_wheels = moving_on_wheels && next == State::Wheels(WheelMotion::Balance);
         self.state = next;
     }
@@ -399,19 +405,19 @@ impl Controller {
         self.goal_rad = self.legs_rad;
     }
 
-    fn leg_goal(&mut self, motion: LegMotion, depth_m: f32) {
+    fn leg_goal(&mut self, depth_m: f32) {
         let config = &self.config;
-        let goals: [Result<LegJoints, _>; 4] = match (motion, self.state) {
-            (LegMotion::Trot(direction), State::Legs(_)) => self.trot.targets(
+        let goals: [Result<LegJoints, _>; 4] = match self.trot_motion() {
+            Some((direction, command)) => self.trot.targets(
                 direction,
                 config.posture.trot_depth_for(self.teleop.body_height_m),
-                self.teleop.speed_scale,
+                &command,
                 &self.sensors.attitude,
                 &config.geometry,
                 &config.limits,
                 &config.posture,
             ),
-            _ => {
+            None => {
                 [config
                     .posture
                     .stance(&config.geometry, &config.limits, depth_m); 4]
@@ -436,58 +442,5 @@ impl Controller {
         for (target, goal) in self.legs_rad.iter_mut().zip(&goal_rad) {
             *target = smoother.step(*target, *goal);
         }
-    }
-
-    fn wheel_law(&mut self, now: Tick, dt_s: f32) -> [f32; 2] {
-        if !self.sensors.attitude_known(now) {
-            return [0.0; 2];
-        }
-        self.set_trim_rules();
-        let config = &self.config;
-        let speed = config.wheel_speed_rad_s * self.teleop.speed_scale;
-        let (velocity_ref_m_s, turn_ref_rad_s) = match self.state {
-            State::Wheels(WheelMotion::Drive(Direction::Forward)) => {
-                (speed * config.balance.wheel_radius_m, 0.0)
-            }
-            State::Wheels(WheelMotion::Drive(Direction::Backward)) => {
-                (-speed * config.balance.wheel_radius_m, 0.0)
-            }
-            State::Wheels(WheelMotion::Rotate) => (0.0, speed),
-            State::Folding(_) => (self.fold_return_m_s(now), 0.0),
-            _ => (0.0, 0.0),
-        };
-        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
-        let common = self.balance.update(
-            &BalanceInput {
-                pitch_rad: self.sensors.attitude.pitch_rad,
-                pitch_rate_rad_s,
-                wheel_rate_rad_s: self.sensors.mean_wheel_rate_rad_s(),
-                velocity_ref_m_s,
-            },
-            dt_s,
-        );
-        if matches!(self.state, State::Wheels(_)) {
-            let input = RunawayInput {
-                ground_speed_m_s: self.ground_speed_m_s(),
-                velocity_ref_m_s: self.balance.velocity_ref_m_s(),
-                torque_nm: common,
-                torque_limit_nm: config.balance.torque_limit_nm,
-            };
-            if let Some(cause) = self.runaway.update(&config.runaway, &input) {
-                self.wheel_fault_stop(now, cause, input.ground_speed_m_s);
-            }
-        }
-        self.turn_ref_rad_s = crate::math::toward(
-            self.turn_ref_rad_s,
-            turn_ref_rad_s,
-            TURN_ACCEL_RAD_S2 * dt_s,
-        );
-        let config = &self.config;
-        let differential = self.turn.update(
-            self.turn_ref_rad_s - self.sensors.differential_wheel_rate_rad_s(),
-            dt_s,
-        );
-        let (left, right) = mix(common, differential, config.wheel_torque_limit_nm);
-        [left, right]
     }
 }

@@ -11,7 +11,7 @@
 //! steady states, `Standing(m)` / `Folding(m)` the transitions that end in them on `PoseReached`.
 //! `—` means the event leaves the state unchanged.
 //!
-//! | state ↓ / event →  | Stop (X), `TeleopLost`, `LinkDegraded`, `LegBlocked` | Stand          | Trot d (L/K)      | Fold             | Wheel w (W/S/A)   | `PoseReached` |
+//! | state ↓ / event →  | Stop (X), `TeleopLost`, `LinkDegraded`, `LegBlocked` | Stand          | Trot d (L/K/Walk) | Fold             | Wheel w (W/S/A/Drive) | `PoseReached` |
 //! |--------------------|----------------------------------------------------|----------------|-------------------|------------------|-------------------|---------------|
 //! | `Hold`             | —                                                    | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | —             |
 //! | `Legs(_)`          | Legs(Stand)                                          | Legs(Stand)    | Legs(Trot d)      | Folding(Balance) | Folding(w)        | —             |
@@ -20,6 +20,9 @@
 //! | `Wheels(_)`        | Wheels(Balance)                                      | Standing(Stand)| Standing(Trot d)  | —                | Wheels(w)         | —             |
 //! | `EStop`            | —                                                    | —              | —                 | —                | —                 | —             |
 //! | `Fault`            | —                                                    | —              | —                 | —                | —                 | —             |
+//!
+//! `Walk` requests `LegMotion::Walk` (the trot at the operator's speed and yaw rate) where the
+//! table says `Trot d`, and `Drive` requests `WheelMotion::Velocity` where it says `w`.
 //!
 //! Events that reach every state alike:
 //!
@@ -49,8 +52,17 @@ pub enum Direction {
 pub enum LegMotion {
     /// Stand still at the commanded body height.
     Stand,
-    /// Trot (diagonal pairs).
+    /// Trot (diagonal pairs) at the preset stride.
     Trot(Direction),
+    /// Trot at the operator's speed and yaw rate ([`TeleopMode::Walk`]).
+    Walk,
+}
+
+impl LegMotion {
+    /// Whether the legs trot (at a preset or at the operator's velocity).
+    pub const fn trotting(self) -> bool {
+        matches!(self, LegMotion::Trot(_) | LegMotion::Walk)
+    }
 }
 
 /// What the wheels do while they carry the robot (always balancing).
@@ -62,6 +74,15 @@ pub enum WheelMotion {
     Drive(Direction),
     /// Turn in place (differential drive).
     Rotate,
+    /// Drive at the operator's speed and yaw rate ([`TeleopMode::Drive`]).
+    Velocity,
+}
+
+impl WheelMotion {
+    /// Whether the wheels are asked to move (not only to balance in place).
+    pub const fn moving(self) -> bool {
+        !matches!(self, WheelMotion::Balance)
+    }
 }
 
 /// The controller's state.
@@ -153,6 +174,8 @@ impl State {
             TeleopMode::WheelForward => self.to_wheels(WheelMotion::Drive(Direction::Forward)),
             TeleopMode::WheelBackward => self.to_wheels(WheelMotion::Drive(Direction::Backward)),
             TeleopMode::WheelRotate => self.to_wheels(WheelMotion::Rotate),
+            TeleopMode::Drive => self.to_wheels(WheelMotion::Velocity),
+            TeleopMode::Walk => self.to_legs(LegMotion::Walk),
         }
     }
 
@@ -183,6 +206,8 @@ impl State {
             State::Wheels(WheelMotion::Drive(Direction::Forward)) => ControllerMode::WheelForward,
             State::Wheels(WheelMotion::Drive(Direction::Backward)) => ControllerMode::WheelBackward,
             State::Wheels(WheelMotion::Rotate) => ControllerMode::WheelRotate,
+            State::Legs(LegMotion::Walk) => ControllerMode::Walking,
+            State::Wheels(WheelMotion::Velocity) => ControllerMode::Driving,
             State::EStop => ControllerMode::EStop,
             State::Fault => ControllerMode::Fault,
         }

@@ -1,7 +1,7 @@
 //! What the operator asked for. Mode requests are edges: a command acts when its mode differs
 //! from the previous command's, so a teleop that keeps repeating `W` after a fault reset does
-//! not restart the motion by itself — the operator has to press a key. Body height and speed
-//! scale are levels and apply on every command.
+//! not restart the motion by itself — the operator has to press a key. Body height, speed
+//! scale, speed and yaw rate are levels and apply on every command.
 //!
 //! On top of the edges sits the **restart interlock** (IEC 60204-1, no unexpected start-up):
 //! after the controller starts, after an E-stop release and after the operator was lost, no
@@ -22,6 +22,10 @@ pub struct Teleop {
     pub body_height_m: f32,
     /// Speed scale, 0…1.
     pub speed_scale: f32,
+    /// Ground speed for `Drive` and `Walk`, m/s, as sent (the controller applies its limits).
+    pub speed_m_s: f32,
+    /// Yaw rate, rad/s, + turning left, as sent (the controller applies its limits).
+    pub yaw_rate_rad_s: f32,
     watchdog: Watchdog,
     alive: bool,
     interlocked: bool,
@@ -35,6 +39,8 @@ impl Teleop {
             last_mode: None,
             body_height_m: 0.0,
             speed_scale: 1.0,
+            speed_m_s: 0.0,
+            yaw_rate_rad_s: 0.0,
             watchdog: Watchdog::new(timeout_ticks),
             alive: false,
             interlocked: true,
@@ -49,6 +55,8 @@ impl Teleop {
         self.alive = true;
         self.body_height_m = command.body_height.si();
         self.speed_scale = crate::math::clamp(command.speed_scale.si() * 0.01, 0.0, 1.0);
+        self.speed_m_s = command.speed.si();
+        self.yaw_rate_rad_s = command.yaw_rate.si();
         let new = self.last_mode != Some(command.mode);
         self.last_mode = Some(command.mode);
         if command.mode == TeleopMode::Stop {
@@ -103,6 +111,8 @@ mod tests {
             body_height: BodyHeight::saturating_from_si(0.05),
             speed_scale: SpeedScale::from_raw(speed_pct)
                 .unwrap_or(SpeedScale::saturating_from_si(0.0)),
+            speed: Default::default(),
+            yaw_rate: Default::default(),
         }
     }
 

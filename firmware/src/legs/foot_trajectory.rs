@@ -61,22 +61,47 @@ impl FootTrajectory {
     /// [`FootTrajectory::duty`] of the cycle and pushes the foot backward, so the body moves
     /// forward; run the phase backward ([`Phase::reversed`]) to walk backward.
     pub fn foot(&self, phase: Phase, depth_m: f32, scale: f32) -> (f32, f32) {
-        let scale = crate::math::clamp(scale, 0.0, 1.0);
-        let half = 0.5 * self.step_length_m * scale;
+        let foot = self.foot_on_stride(phase, depth_m, crate::math::clamp(scale, 0.0, 1.0), 0.0);
+        (foot.x_m, foot.z_m)
+    }
+
+    /// The foot position at `phase` for a stride of `along` full strides fore–aft and `across`
+    /// full strides to the left (each −1…1; a turning trot's legs stride differently and
+    /// sideways): stance carries the foot from `+(along, across)·L/2` to `−(along, across)·L/2`
+    /// around the stride's centre, and swing back through the air. A foot with no stride
+    /// stays down.
+    pub fn foot_on_stride(&self, phase: Phase, depth_m: f32, along: f32, across: f32) -> FootPoint {
+        let half = 0.5 * self.step_length_m;
         let fraction = phase.fraction();
         let duty = crate::math::clamp(self.duty, 0.5, 0.9);
-        if fraction < duty {
-            let s = fraction / duty;
-            (self.centre_x_m + half - 2.0 * half * s, -depth_m)
+        // Where the foot is along its stride, +1 at touchdown to −1 at lift-off.
+        let (u, lift) = if fraction < duty {
+            (1.0 - 2.0 * fraction / duty, 0.0)
         } else {
             let s = (fraction - duty) / (1.0 - duty);
-            let x = self.centre_x_m - half + 2.0 * half * 0.5 * (1.0 - cos(PI * s));
-            let lift = if scale > 0.0 {
+            let striding = along != 0.0 || across != 0.0;
+            let lift = if striding {
                 self.clearance_m * sin(PI * s)
             } else {
                 0.0
             };
-            (x, -depth_m + lift)
+            (-cos(PI * s), lift)
+        };
+        FootPoint {
+            x_m: self.centre_x_m + half * along * u,
+            y_m: half * across * u,
+            z_m: -depth_m + lift,
         }
     }
+}
+
+/// A foot position in the leg frame (x forward, y left, z up, origin at the hip), m.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FootPoint {
+    /// Forward.
+    pub x_m: f32,
+    /// Left.
+    pub y_m: f32,
+    /// Up (negative below the hip).
+    pub z_m: f32,
 }

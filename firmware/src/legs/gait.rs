@@ -10,6 +10,7 @@ use protocol::Leg;
 use crate::attitude::Attitude;
 use crate::control::fsm::Direction;
 use crate::legs::foot_trajectory::FootTrajectory;
+use crate::legs::hips::HipLayout;
 use crate::legs::kinematics::{IkError, LegGeometry, LegJoints};
 use crate::legs::phase::{Phase, PhaseStep, HALF_CYCLE};
 use crate::legs::posture::Posture;
@@ -79,6 +80,37 @@ pub struct TrotParams {
     pub generator: Generator,
     /// How the stance legs level the body (the Cartesian generator only).
     pub body_level: BodyLevel,
+    /// Where the legs attach: a turning trot strides each foot along its hip's path.
+    pub hips: HipLayout,
+}
+
+/// What the trot's stance feet carry the body at.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TrotCommand {
+    /// Speed in the trot's direction as a share of the full stride's speed (0…1).
+    pub stride_share: f32,
+    /// Yaw rate, rad/s, + turning left (the Cartesian generator only).
+    pub yaw_rate_rad_s: f32,
+}
+
+impl TrotCommand {
+    /// Straight on at `stride_share` of the full stride.
+    pub const fn straight(stride_share: f32) -> Self {
+        Self {
+            stride_share,
+            yaw_rate_rad_s: 0.0,
+        }
+    }
+}
+
+/// One leg's stride in a trot, as shares of the full stride (the foot path's length), in the
+/// trot's direction: `along` fore–aft, `across` to the left.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LegStride {
+    /// Fore–aft share.
+    pub along: f32,
+    /// Sideways share.
+    pub across: f32,
 }
 
 impl TrotParams {
@@ -90,12 +122,14 @@ impl TrotParams {
             roll_m_per_rad: 0.05,
             limit_m: 0.02,
         },
+        hips: HipLayout::ROBOT,
     };
     /// The report's gait: 1 Hz joint-space sinusoids.
     pub const REPORT: Self = Self {
         frequency_millihz: 1000,
         generator: Generator::Sine(SineGait::REPORT),
         body_level: BodyLevel::OFF,
+        hips: HipLayout::ROBOT,
     };
 }
 
@@ -182,24 +216,82 @@ impl Trot {
         })
     }
 
+    /// The body speed of the full stride, m/s: a stance carries the foot one stride length in
+    /// the duty's share of the cycle (`None` for the report's sinusoids, which have no stride
+    /// in metres).
+    pub fn full_speed_m_s(&self) -> Option<f32> {
+        match self.params.generator {
+            Generator::Cartesian(path) => {
+                let duty = crate::math::clamp(path.duty, 0.5, 0.9);
+                let frequency_hz = self.params.frequency_millihz as f32 * 1e-3;
+                Some(path.step_length_m * frequency_hz / duty)
+            }
+            Generator::Sine(_) => None,
+        }
+    }
+
+    /// Every leg's stride for `command` walking in `direction`, in [`Leg::ALL`] order. A yaw
+    /// rate ω moves each hip at `(v − ω·y, ω·x)` over the ground; its foot strides against
+    /// that. When a leg would need more than the full stride, all strides shrink alike, so that
+    /// the turn keeps its radius.
+    pub fn strides(&self, direction: Direction, command: &TrotCommand) -> [LegStride; 4] {
+        let share = crate::math::clamp(command.stride_share, 0.0, 1.0);
+        let turn = match self.full_speed_m_s() {
+            Some(full) if command.yaw_rate_rad_s.is_finite() => command.yaw_rate_rad_s / full,
+            _ => 0.0,
+        };
+        // Walking backward the phase runs backward, and with it the stride's sense.
+        let sign = match direction {
+            Direction::Forward => 1.0,
+            Direction::Backward => -1.0,
+        };
+        let strides = Leg::ALL.map(|leg| {
+            let (x_m, y_m) = self.params.hips.offset_m(leg);
+            LegStride {
+                along: if share.is_nan() { 0.0 } else { share } - sign * turn * y_m,
+                across: sign * turn * x_m,
+            }
+        });
+        let longest = strides.iter().fold(0.0_f32, |most, stride| {
+            most.max(crate::math::sqrt(
+                stride.along * stride.along + stride.across * stride.across,
+            ))
+        });
+        if longest > 1.0 {
+            strides.map(|stride| LegStride {
+                along: stride.along / longest,
+                across: stride.across / longest,
+            })
+        } else {
+            strides
+        }
+    }
+
+    /// `leg`'s stride for `command` walking in `direction` (see [`Trot::strides`]).
+    pub fn stride(&self, leg: Leg, direction: Direction, command: &TrotCommand) -> LegStride {
+        stride_of(&self.strides(direction, command), leg)
+    }
+
     /// Joint targets of all four legs (in [`Leg::ALL`] order) at the present phase, for a
-    /// stance `depth_m` below the hips, a stride scaled by `scale` (0…1) and the body at
+    /// stance `depth_m` below the hips, the stride `command` asks for and the body at
     /// `attitude` ([`BodyLevel`]).
     #[allow(clippy::too_many_arguments)]
     pub fn targets(
         &self,
         direction: Direction,
         depth_m: f32,
-        scale: f32,
+        command: &TrotCommand,
         attitude: &Attitude,
         geometry: &LegGeometry,
         limits: &JointLimits,
         posture: &Posture,
     ) -> [Result<LegJoints, IkError>; 4] {
+        let strides = self.strides(direction, command);
         Leg::ALL.map(|leg| {
+            let stride = stride_of(&strides, leg);
             let phase = self.leg_phase(leg, direction);
             match self.params.generator {
-                Generator::Sine(sine) => Ok(sine.joints(phase, scale)),
+                Generator::Sine(sine) => Ok(sine.joints(phase, command.stride_share)),
                 Generator::Cartesian(path) => {
                     let level_m = self.params.body_level.depth_offset_m(leg, attitude);
                     // Within the trot's reach: the swing arc rises above the stance line.
@@ -208,10 +300,21 @@ impl Trot {
                         posture.trot_depth_min_m,
                         posture.depth_max_m,
                     );
-                    let (x_m, z_m) = path.foot(phase, leg_depth_m, scale);
-                    posture.foot_ik(geometry, limits, x_m, -z_m)
+                    let foot = path.foot_on_stride(phase, leg_depth_m, stride.along, stride.across);
+                    posture.foot_ik_at(geometry, limits, foot.x_m, foot.y_m, -foot.z_m)
                 }
             }
         })
+    }
+}
+
+/// `leg`'s entry of `strides` (in [`Leg::ALL`] order).
+const fn stride_of(strides: &[LegStride; 4], leg: Leg) -> LegStride {
+    let [fl, fr, bl, br] = *strides;
+    match leg {
+        Leg::Fl => fl,
+        Leg::Fr => fr,
+        Leg::Bl => bl,
+        Leg::Br => br,
     }
 }

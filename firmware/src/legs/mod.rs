@@ -1,4 +1,4 @@
-//! The legs: [`kinematics`] (IK/FK of one leg), the poses ([`posture`]: the stance; the fold and
+//! The legs: where they attach ([`hips`]), [`kinematics`] (IK/FK of one leg), the poses ([`posture`]: the stance; the fold and
 //! its [`levelling`]), the trot ([`gait`] with its [`phase`] clock, [`foot_trajectory`], the
 //! watch for a swing it cannot finish ([`blocked`]) and the report's [`sine_gait`]), the
 //! quasi-static [`crawl`] (moves for a climb, not used yet), [`smoothing`] of targets,
@@ -9,6 +9,7 @@ pub mod blocked;
 pub mod crawl;
 pub mod foot_trajectory;
 pub mod gait;
+pub mod hips;
 pub mod kinematics;
 pub mod levelling;
 pub mod phase;

@@ -105,12 +105,25 @@ impl Posture {
         x_m: f32,
         depth_m: f32,
     ) -> Result<LegJoints, IkError> {
+        self.foot_ik_at(geometry, limits, x_m, 0.0, depth_m)
+    }
+
+    /// Joint angles that put the foot at `(x_m, y_m, −depth_m)` with the scheduled pitch (the
+    /// abduction takes `y_m`; the pitch is scheduled on the depth within the abducted plane).
+    pub fn foot_ik_at(
+        &self,
+        geometry: &LegGeometry,
+        limits: &JointLimits,
+        x_m: f32,
+        y_m: f32,
+        depth_m: f32,
+    ) -> Result<LegJoints, IkError> {
         leg_ik(
             geometry,
             limits,
             &FootTarget {
                 x_m,
-                y_m: 0.0,
+                y_m,
                 z_m: -depth_m,
                 pitch_rad: self.foot_pitch_rad(x_m, depth_m),
             },

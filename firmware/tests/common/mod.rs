@@ -125,5 +125,7 @@ pub fn command(mode: TeleopMode) -> AnyMessage {
         mode,
         body_height: BodyHeight::saturating_from_si(0.0),
         speed_scale: SpeedScale::from_raw(100).unwrap(),
+        speed: Default::default(),
+        yaw_rate: Default::default(),
     })
 }

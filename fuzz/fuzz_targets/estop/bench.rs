@@ -219,6 +219,8 @@ impl Bench {
             mode: TeleopMode::from_raw(mode % 8).unwrap_or(TeleopMode::Stop),
             body_height: BodyHeight::saturating_from_si(f32::from(height as i8) * 1e-3),
             speed_scale: SpeedScale::saturating_from_si(f32::from(speed % 101)),
+            speed: Default::default(),
+            yaw_rate: Default::default(),
         };
         self.last_command = Some(command);
         self.seal_and_send(Who::Teleop, &AnyMessage::TeleopCommand(command));

@@ -252,6 +252,8 @@ impl Bus {
                     mode: TeleopMode::ALL[(t / 50) as usize % TeleopMode::ALL.len()],
                     body_height: BodyHeight::default(),
                     speed_scale: SpeedScale::from_raw(50).unwrap(),
+                    speed: Default::default(),
+                    yaw_rate: Default::default(),
                 }),
             );
         }

@@ -30,6 +30,8 @@ raw_strategy!(rate, AngularRate, i16);
 raw_strategy!(accel, Acceleration, i16);
 raw_strategy!(height, BodyHeight, i16);
 raw_strategy!(speed, SpeedScale, u8);
+raw_strategy!(ground_speed, GroundSpeed, i16);
+raw_strategy!(yaw_rate, YawRate, i16);
 raw_strategy!(tick, Tick, u32);
 raw_strategy!(millis, Millis, u32);
 raw_strategy!(count, Count, u16);
@@ -95,13 +97,22 @@ pub fn any_message() -> impl Strategy<Value = AnyMessage> {
                 angular_rate,
                 acceleration
             })),
-        (pick(TeleopMode::ALL), height(), speed()).prop_map(|(mode, body_height, speed_scale)| {
-            AnyMessage::TeleopCommand(TeleopCommand {
-                mode,
-                body_height,
-                speed_scale,
-            })
-        }),
+        (
+            pick(TeleopMode::ALL),
+            height(),
+            speed(),
+            ground_speed(),
+            yaw_rate()
+        )
+            .prop_map(|(mode, body_height, speed_scale, speed, yaw_rate)| {
+                AnyMessage::TeleopCommand(TeleopCommand {
+                    mode,
+                    body_height,
+                    speed_scale,
+                    speed,
+                    yaw_rate,
+                })
+            }),
         millis().prop_map(|uptime| AnyMessage::TeleopHeartbeat(TeleopHeartbeat { uptime })),
         (
             pick(ControllerMode::ALL),

@@ -9,6 +9,8 @@ pub fn teleop(mode: TeleopMode) -> TeleopCommand {
         mode,
         body_height: BodyHeight::from_si(0.0).unwrap(),
         speed_scale: SpeedScale::from_si(100.0).unwrap(),
+        speed: Default::default(),
+        yaw_rate: Default::default(),
     }
 }
 

@@ -81,6 +81,8 @@ pub(super) fn forged_commands(model: &Path) -> Result<CellResult, SessionError> 
         mode: TeleopMode::Stand,
         body_height: BodyHeight::saturating_from_si(0.0),
         speed_scale: SpeedScale::saturating_from_si(100.0),
+        speed: Default::default(),
+        yaw_rate: Default::default(),
     });
     let mut sent = 0_u64;
     let every = (20_000 / PERIOD_US).max(1);

@@ -71,6 +71,8 @@ pub fn plan(steps: &[(f64, &str)]) -> (Vec<PlanStep>, Vec<SegmentSpec>) {
             mode: parse_mode(mode).unwrap(),
             body_height_m: 0.0,
             speed_scale_pct: 100.0,
+            speed_m_s: 0.0,
+            yaw_rate_rad_s: 0.0,
         })
         .collect();
     let segments = steps

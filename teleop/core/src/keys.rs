@@ -7,6 +7,7 @@
 //! | `X`            | stop                                     |
 //! | `T` / `F`      | stand on the legs / fold onto the wheels |
 //! | `↑` `↓`        | body height +1 cm / −1 cm                |
+//! | `←` `→`        | steer: yaw rate +0.1 / −0.1 rad/s (turn left / right) while driving or trotting; a mode key straightens |
 //! | `]` `[`        | speed scale +10 % / −10 %                |
 //! | space          | E-stop (latches)                         |
 //! | `R` then `R`   | release a latched E-stop (within 2 s)    |
@@ -23,6 +24,10 @@ pub enum Key {
     Up,
     /// Arrow down.
     Down,
+    /// Arrow left.
+    Left,
+    /// Arrow right.
+    Right,
     /// Escape.
     Esc,
 }
@@ -36,6 +41,8 @@ pub enum Action {
     Height(f32),
     /// Change the speed scale by this much, %.
     Speed(f32),
+    /// Change the yaw rate that steers the moving keys by this much, rad/s (+ left).
+    Steer(f32),
     /// Latch the E-stop.
     EStop,
     /// One press of the release sequence.
@@ -44,8 +51,11 @@ pub enum Action {
     Quit,
 }
 
+/// One press of `←` or `→`, rad/s.
+pub const STEER_STEP_RAD_S: f32 = 0.1;
+
 /// The report's key for `mode`, if it has one (stand and fold have none: `T` and `F` are this
-/// program's).
+/// program's; drive and walk follow a gamepad's sticks).
 pub const fn mode_key(mode: TeleopMode) -> Option<char> {
     match mode {
         TeleopMode::Stop => Some('X'),
@@ -54,7 +64,7 @@ pub const fn mode_key(mode: TeleopMode) -> Option<char> {
         TeleopMode::WheelRotate => Some('A'),
         TeleopMode::TrotForward => Some('L'),
         TeleopMode::TrotBackward => Some('K'),
-        TeleopMode::Stand | TeleopMode::Fold => None,
+        TeleopMode::Stand | TeleopMode::Fold | TeleopMode::Drive | TeleopMode::Walk => None,
     }
 }
 
@@ -76,6 +86,8 @@ pub fn action(key: Key) -> Option<Action> {
     Some(match key {
         Key::Up => Action::Height(0.01),
         Key::Down => Action::Height(-0.01),
+        Key::Left => Action::Steer(STEER_STEP_RAD_S),
+        Key::Right => Action::Steer(-STEER_STEP_RAD_S),
         Key::Esc => Action::Quit,
         Key::Char(c) => match c.to_ascii_uppercase() {
             ' ' => Action::EStop,

@@ -7,7 +7,7 @@
 
 use protocol::{
     AnyMessage, BodyHeight, ControllerMode, EStop, EStopAction, EncodeError, Frame, Millis, NodeId,
-    SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, TEST_KEY,
+    SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, YawRate, TEST_KEY,
 };
 
 use crate::keys::Action;
@@ -28,6 +28,9 @@ pub const LATCH_REPEAT_MS: u64 = 4;
 pub const RELEASE_WINDOW_MS: u64 = 2_000;
 /// Body-height range of the wire, m.
 pub const BODY_HEIGHT_RANGE_M: (f32, f32) = (-0.10, 0.12);
+/// The keys' steering range, rad/s: the controller's own limits are tighter on the legs
+/// (0.4 rad/s) and take what it can.
+pub const STEER_RANGE_RAD_S: f32 = 1.0;
 
 /// What a key press led to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -44,6 +47,8 @@ pub struct Operator {
     mode: TeleopMode,
     body_height_m: f32,
     speed_scale_pct: f32,
+    /// Yaw rate that steers the moving keys, rad/s, + left.
+    yaw_rate_rad_s: f32,
     estop_latched: bool,
     /// Whether the controller has reported its E-stop since this operator's last latch.
     estop_confirmed: bool,
@@ -76,6 +81,7 @@ impl Operator {
             mode: TeleopMode::Stop,
             body_height_m: 0.0,
             speed_scale_pct: 100.0,
+            yaw_rate_rad_s: 0.0,
             estop_latched: false,
             estop_confirmed: false,
             latch_sent_ms: None,
@@ -141,6 +147,11 @@ impl Operator {
         self.speed_scale_pct
     }
 
+    /// The commanded yaw rate, rad/s, + left: it steers `W`, `S`, `L` and `K`.
+    pub fn yaw_rate_rad_s(&self) -> f32 {
+        self.yaw_rate_rad_s
+    }
+
     /// Whether this operator latched an E-stop that is not yet released.
     pub fn estop_latched(&self) -> bool {
         self.estop_latched
@@ -174,8 +185,18 @@ impl Operator {
         }
         match action {
             Action::Mode(mode) => {
-                self.command_changed |= mode != self.mode;
+                // Every motion starts straight.
+                self.command_changed |= mode != self.mode || self.yaw_rate_rad_s != 0.0;
                 self.mode = mode;
+                self.yaw_rate_rad_s = 0.0;
+            }
+            Action::Steer(step_rad_s) => {
+                let yaw =
+                    (self.yaw_rate_rad_s + step_rad_s).clamp(-STEER_RANGE_RAD_S, STEER_RANGE_RAD_S);
+                // Whole hundredths, so repeated steps do not drift.
+                let yaw = (yaw * 100.0).round() / 100.0;
+                self.command_changed |= yaw != self.yaw_rate_rad_s;
+                self.yaw_rate_rad_s = yaw;
             }
             Action::Height(step_m) => {
                 let (low, high) = BODY_HEIGHT_RANGE_M;
@@ -199,6 +220,7 @@ impl Operator {
                 self.pending_estop = Some(EStopAction::Latch);
                 // After a stop, motion must be asked for again.
                 self.mode = TeleopMode::Stop;
+                self.yaw_rate_rad_s = 0.0;
                 self.command_changed = true;
             }
             Action::Release => {
@@ -256,6 +278,8 @@ impl Operator {
                 mode: self.mode,
                 body_height: BodyHeight::saturating_from_si(self.body_height_m),
                 speed_scale: SpeedScale::saturating_from_si(self.speed_scale_pct),
+                speed: Default::default(),
+                yaw_rate: YawRate::saturating_from_si(self.yaw_rate_rad_s),
             });
             // Before the session is joined nothing goes out, and a change waits for it.
             if let Some(frame) = self.link.seal(&command)? {

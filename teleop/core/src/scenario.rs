@@ -7,13 +7,15 @@
 //!
 //! [[step]]
 //! at_s = 0.0
-//! mode = "fold"               # W S A L K X (the report's keys), stand, fold
+//! mode = "fold"               # W S A L K X (the report's keys), stand, fold, drive, walk
 //!
 //! [[step]]
 //! at_s = 3.0
 //! mode = "W"
 //! body_height_m = 0.0         # optional, −0.10…+0.12 (default 0)
 //! speed_scale_pct = 100       # optional, 0…100 (default 100)
+//! yaw_rate_rad_s = 0.3        # optional, −3…3, + left: steers W S L K drive walk (default 0)
+//! # speed_m_s = 0.3           # drive and walk only: ground speed, −2…2 m/s (default 0)
 //! label = "drive"             # optional name of the segment in the summary
 //!
 //! [scene]                     # optional: the simulator's ground (sim-host reads it)
@@ -104,14 +106,19 @@ struct RawStep {
     mode: Spanned<String>,
     body_height_m: Option<Spanned<f64>>,
     speed_scale_pct: Option<Spanned<f64>>,
+    speed_m_s: Option<Spanned<f64>>,
+    yaw_rate_rad_s: Option<Spanned<f64>>,
     label: Option<String>,
 }
 
-/// The mode a scenario (or `--drive`) names: the report's keys W S A L K X, `stand`, `fold`.
+/// The mode a scenario (or `--drive`) names: the report's keys W S A L K X, `stand`, `fold`,
+/// `drive` and `walk` (at a ground speed and yaw rate).
 pub fn parse_mode(text: &str) -> Option<TeleopMode> {
     match text.trim().to_ascii_lowercase().as_str() {
         "stand" => Some(TeleopMode::Stand),
         "fold" => Some(TeleopMode::Fold),
+        "drive" => Some(TeleopMode::Drive),
+        "walk" => Some(TeleopMode::Walk),
         key => {
             let mut chars = key.chars();
             match (chars.next(), chars.next()) {
@@ -122,11 +129,73 @@ pub fn parse_mode(text: &str) -> Option<TeleopMode> {
     }
 }
 
-/// The label of a mode in summaries: the report's key, or `stand` / `fold`.
+/// A plan step as a command line gives it (`--drive`): `SECONDS:MODE[,speed=M_S][,yaw=RAD_S]`,
+/// e.g. `2:W`, `6:W,yaw=0.3`, `4:drive,speed=0.3,yaw=-0.2`; the same checks as a scenario
+/// file's step, with a message naming the part that is wrong.
+pub fn parse_drive_step(text: &str) -> Result<PlanStep, String> {
+    let (time, rest) = text
+        .split_once(':')
+        .ok_or_else(|| format!("`{text}`: expected SECONDS:MODE, e.g. 2:W or 4:drive,speed=0.3"))?;
+    let seconds: f64 = time
+        .trim()
+        .parse()
+        .map_err(|_| format!("`{time}` is not a number of seconds"))?;
+    if !(0.0..=1e6).contains(&seconds) {
+        return Err(format!("`{time}`: time must be 0…1e6 s"));
+    }
+    let mut parts = rest.split(',');
+    let mode_text = parts.next().unwrap_or_default();
+    let mode = parse_mode(mode_text)
+        .ok_or_else(|| format!("`{mode_text}`: use W S A L K X, stand, fold, drive or walk"))?;
+    let mut step = PlanStep::at(seconds, mode);
+    for part in parts {
+        let (key, value) = part
+            .split_once('=')
+            .ok_or_else(|| format!("`{part}`: expected speed=M_S or yaw=RAD_S"))?;
+        let number = |range: std::ops::RangeInclusive<f32>, unit: &str| {
+            value
+                .trim()
+                .parse::<f32>()
+                .ok()
+                .filter(|v| range.contains(v))
+                .ok_or_else(|| {
+                    format!(
+                        "`{part}`: give {key} from {} to {} {unit}",
+                        range.start(),
+                        range.end()
+                    )
+                })
+        };
+        match key.trim() {
+            "speed" if matches!(mode, TeleopMode::Drive | TeleopMode::Walk) => {
+                step.speed_m_s = number(-2.0..=2.0, "m/s")?;
+            }
+            "speed" => return Err(format!("`{part}`: only drive and walk take a speed")),
+            "yaw"
+                if !matches!(
+                    mode,
+                    TeleopMode::Stop
+                        | TeleopMode::WheelRotate
+                        | TeleopMode::Stand
+                        | TeleopMode::Fold
+                ) =>
+            {
+                step.yaw_rate_rad_s = number(-3.0..=3.0, "rad/s")?;
+            }
+            "yaw" => return Err(format!("`{part}`: {} ignores a yaw rate", mode_name(mode))),
+            other => return Err(format!("`{other}`: expected speed=M_S or yaw=RAD_S")),
+        }
+    }
+    Ok(step)
+}
+
+/// The label of a mode in summaries: the report's key, or `stand` / `fold` / `drive` / `walk`.
 pub fn mode_name(mode: TeleopMode) -> String {
     match mode {
         TeleopMode::Stand => "stand".into(),
         TeleopMode::Fold => "fold".into(),
+        TeleopMode::Drive => "drive".into(),
+        TeleopMode::Walk => "walk".into(),
         other => mode_key(other).map(String::from).unwrap_or_default(),
     }
 }
@@ -227,7 +296,7 @@ impl Source<'_> {
             self.value_error(
                 s.mode.span().start,
                 format!(
-                    "mode = \"{}\": use W, S, A, L, K, X, stand or fold",
+                    "mode = \"{}\": use W, S, A, L, K, X, stand, fold, drive or walk",
                     s.mode.get_ref()
                 ),
             )
@@ -238,15 +307,48 @@ impl Source<'_> {
         let speed_scale_pct = self.in_range(&s.speed_scale_pct, 0.0..=100.0, 100.0, |v| {
             format!("speed_scale_pct = {v}: the range is 0…100")
         })?;
+        let (speed_m_s, yaw_rate_rad_s) = self.velocity(s, mode)?;
         Ok(Step {
             plan: PlanStep {
                 at_us: (at_s * 1e6).round() as u64,
                 mode,
                 body_height_m: body_height_m as f32,
                 speed_scale_pct: speed_scale_pct as f32,
+                speed_m_s: speed_m_s as f32,
+                yaw_rate_rad_s: yaw_rate_rad_s as f32,
             },
             label: s.label.clone().unwrap_or_else(|| mode_name(mode)),
         })
+    }
+
+    /// The step's ground speed and yaw rate, each refused for a mode that ignores it.
+    fn velocity(&self, s: &RawStep, mode: TeleopMode) -> Result<(f64, f64), ScenarioError> {
+        let velocity_mode = matches!(mode, TeleopMode::Drive | TeleopMode::Walk);
+        let steered = velocity_mode
+            || matches!(
+                mode,
+                TeleopMode::WheelForward
+                    | TeleopMode::WheelBackward
+                    | TeleopMode::TrotForward
+                    | TeleopMode::TrotBackward
+            );
+        let name = mode_name(mode);
+        if let (Some(v), false) = (&s.speed_m_s, velocity_mode) {
+            let message = format!("speed_m_s: mode {name} ignores it; use drive or walk");
+            return Err(self.value_error(v.span().start, message));
+        }
+        if let (Some(v), false) = (&s.yaw_rate_rad_s, steered) {
+            let message =
+                format!("yaw_rate_rad_s: mode {name} ignores it; use W, S, L, K, drive or walk");
+            return Err(self.value_error(v.span().start, message));
+        }
+        let speed = self.in_range(&s.speed_m_s, -2.0..=2.0, 0.0, |v| {
+            format!("speed_m_s = {v}: the range is −2…+2 m/s")
+        })?;
+        let yaw = self.in_range(&s.yaw_rate_rad_s, -3.0..=3.0, 0.0, |v| {
+            format!("yaw_rate_rad_s = {v}: the range is −3…+3 rad/s")
+        })?;
+        Ok((speed, yaw))
     }
 
     /// An optional value, `default` when absent, an error naming it when outside `range`.
@@ -290,6 +392,41 @@ mod tests {
     }
 
     #[test]
+    fn drive_and_walk_take_a_speed_and_the_moving_keys_a_yaw_rate() {
+        let s = parse(
+            "duration_s = 9\n[[step]]\nat_s = 0\nmode = \"drive\"\nspeed_m_s = -0.3\nyaw_rate_rad_s = 0.3\n[[step]]\nat_s = 4\nmode = \"L\"\nyaw_rate_rad_s = -0.2\n",
+        )
+        .unwrap();
+        assert_eq!(s.steps[0].plan.mode, TeleopMode::Drive);
+        assert_eq!(s.steps[0].plan.speed_m_s, -0.3);
+        assert_eq!(s.steps[0].plan.yaw_rate_rad_s, 0.3);
+        assert_eq!(s.steps[0].label, "drive");
+        assert_eq!(s.steps[1].plan.yaw_rate_rad_s, -0.2);
+        assert_eq!(s.steps[1].plan.speed_m_s, 0.0);
+    }
+
+    #[test]
+    fn a_command_line_step_takes_a_speed_and_a_yaw_rate() {
+        let step = parse_drive_step("4:drive,speed=0.3,yaw=-0.2").unwrap();
+        assert_eq!(
+            (step.mode, step.speed_m_s, step.yaw_rate_rad_s, step.at_us),
+            (TeleopMode::Drive, 0.3, -0.2, 4_000_000)
+        );
+        assert_eq!(parse_drive_step("6:W,yaw=0.3").unwrap().yaw_rate_rad_s, 0.3);
+        for (bad, needle) in [
+            ("4:W,speed=0.3", "only drive and walk"),
+            ("4:A,yaw=0.3", "ignores a yaw rate"),
+            ("4:walk,speed=9", "from -2 to 2 m/s"),
+            ("4:walk,spin=1", "expected speed=M_S"),
+            ("4:Q", "use W S A L K X"),
+            ("x:W", "not a number"),
+        ] {
+            let err = parse_drive_step(bad).unwrap_err();
+            assert!(err.contains(needle), "{bad}: {err}");
+        }
+    }
+
+    #[test]
     fn errors_name_the_line() {
         let cases = [
             ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"Q\"\n", 4, "use W, S, A"),
@@ -299,6 +436,9 @@ mod tests {
             ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"W\"\nspeed = 3\n", 5, "unknown field"),
             ("duration_s = 6\n[[step]\nat_s = 0\n", 2, ""),
             ("duration_s = -1\n[[step]]\nat_s = 0\nmode = \"W\"\n", 1, "0 < duration_s"),
+            ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"W\"\nspeed_m_s = 0.3\n", 5, "use drive or walk"),
+            ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"A\"\nyaw_rate_rad_s = 0.3\n", 5, "ignores it"),
+            ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"drive\"\nspeed_m_s = 3\n", 5, "−2…+2 m/s"),
         ];
         for (text, line, needle) in cases {
             let err = parse(text).unwrap_err();

@@ -9,8 +9,8 @@
 //! takes a STOP step in the plan, as it takes an operator's X.
 
 use protocol::{
-    AnyMessage, BodyHeight, EncodeError, FaultFlags, Frame, Millis, SpeedScale, TeleopCommand,
-    TeleopHeartbeat, TeleopMode, TEST_KEY,
+    AnyMessage, BodyHeight, EncodeError, FaultFlags, Frame, GroundSpeed, Millis, SpeedScale,
+    TeleopCommand, TeleopHeartbeat, TeleopMode, YawRate, TEST_KEY,
 };
 
 use crate::link::OperatorLink;
@@ -31,6 +31,10 @@ pub struct PlanStep {
     pub body_height_m: f32,
     /// Speed scale, % (0…100).
     pub speed_scale_pct: f32,
+    /// Ground speed for `drive` and `walk`, m/s.
+    pub speed_m_s: f32,
+    /// Yaw rate, rad/s, + left: steers W, S, L, K, `drive` and `walk`.
+    pub yaw_rate_rad_s: f32,
 }
 
 impl PlanStep {
@@ -42,6 +46,25 @@ impl PlanStep {
             mode,
             body_height_m: 0.0,
             speed_scale_pct: 100.0,
+            speed_m_s: 0.0,
+            yaw_rate_rad_s: 0.0,
+        }
+    }
+
+    /// This step at `speed_scale_pct` of the mode's preset speed.
+    pub fn with_speed_scale(self, speed_scale_pct: f32) -> Self {
+        Self {
+            speed_scale_pct,
+            ..self
+        }
+    }
+
+    /// This step with a ground speed and a yaw rate.
+    pub fn with_velocity(self, speed_m_s: f32, yaw_rate_rad_s: f32) -> Self {
+        Self {
+            speed_m_s,
+            yaw_rate_rad_s,
+            ..self
         }
     }
 }
@@ -131,6 +154,8 @@ impl ScriptedTeleop {
                 mode,
                 body_height: BodyHeight::saturating_from_si(step.body_height_m),
                 speed_scale: SpeedScale::saturating_from_si(step.speed_scale_pct),
+                speed: GroundSpeed::saturating_from_si(step.speed_m_s),
+                yaw_rate: YawRate::saturating_from_si(step.yaw_rate_rad_s),
             });
             if let Some(frame) = self.link.seal(&command)? {
                 self.stop_sent |= mode == TeleopMode::Stop;

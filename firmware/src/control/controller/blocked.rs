@@ -4,7 +4,7 @@
 use protocol::Leg;
 
 use super::Controller;
-use crate::control::fsm::{Direction, Event, LegMotion, State};
+use crate::control::fsm::{Direction, Event};
 use crate::legs::blocked::lag_m;
 use crate::legs::kinematics::LegJoints;
 
@@ -17,7 +17,7 @@ impl Controller {
     /// [`protocol::FaultFlags::LEG_BLOCKED`] until the operator's next request.
     #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
     pub(super) fn watch_swings(&mut self) {
-        let State::Legs(LegMotion::Trot(direction)) = self.state else {
+        let Some((direction, command)) = self.trot_motion() else {
             return;
         };
         let (leading, sign) = match direction {
@@ -25,19 +25,20 @@ impl Controller {
             Direction::Backward => ([Leg::Bl, Leg::Br], -1.0),
         };
         let config = self.config.blocked;
-        // The stride, and with it how far a stopped foot falls behind, shrinks with the speed
-        // scale; the lag is judged as at full stride. Below the configured scale a riser cannot
-        // be told from flat ground's lags, and the trot is not watched.
-        let scale = self.teleop.speed_scale;
-        if scale.is_nan() || scale < config.min_scale {
-            return;
-        }
         let mut next = self.trot;
         next.advance();
         for leg in leading {
             let share = self.trot.swing_share(leg, direction).unwrap_or(0.0);
             let after = next.swing_share(leg, direction).unwrap_or(0.0);
             if !(share < config.at_swing && after >= config.at_swing) {
+                continue;
+            }
+            // The stride, and with it how far a stopped foot falls behind, shrinks with the
+            // speed (and, turning, differs by leg); the lag is judged as at full stride. Below
+            // the configured share a riser cannot be told from flat ground's lags, and the leg
+            // is not watched.
+            let scale = self.trot.stride(leg, direction, &command).along;
+            if scale.is_nan() || scale < config.min_scale {
                 continue;
             }
             let target = LegJoints::from_array(*self.legs_rad.leg(leg));

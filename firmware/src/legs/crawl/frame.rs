@@ -5,6 +5,7 @@
 
 use protocol::Leg;
 
+use crate::legs::hips::HipLayout;
 use crate::legs::kinematics::{leg_fk, leg_ik, FootTarget, IkError, LegGeometry, LegJoints};
 use crate::limits::JointLimits;
 use crate::math::{cos, deg_to_rad, sin};
@@ -110,10 +111,8 @@ impl<T: Copy> PerLeg<T> {
 /// (depth − 0.33 m)` keeps every joint 5.9° inside its range over all of them.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CrawlGeometry {
-    /// The hips' distance ahead of and behind the torso's centre, m.
-    pub hip_x_m: f32,
-    /// The hips' distance left and right of the torso's centre, m.
-    pub hip_y_m: f32,
+    /// Where the hips are on the torso.
+    pub hips: HipLayout,
     /// Foot sphere radius, m.
     pub foot_radius_m: f32,
     /// φ at x = 0 and the reference depth, rad.
@@ -129,8 +128,7 @@ pub struct CrawlGeometry {
 impl CrawlGeometry {
     /// The robot (hips at ±0.22 m, ±0.15 m; foot radius 0.035 m).
     pub const ROBOT: Self = Self {
-        hip_x_m: 0.22,
-        hip_y_m: 0.15,
+        hips: HipLayout::ROBOT,
         foot_radius_m: 0.035,
         pitch_base_rad: deg_to_rad(-96.0),
         pitch_per_x_rad_m: deg_to_rad(175.0),
@@ -140,12 +138,7 @@ impl CrawlGeometry {
 
     /// `leg`'s hip in the torso's frame (x forward, y left), m.
     pub fn hip_offset_m(&self, leg: Leg) -> (f32, f32) {
-        match leg {
-            Leg::Fl => (self.hip_x_m, self.hip_y_m),
-            Leg::Fr => (self.hip_x_m, -self.hip_y_m),
-            Leg::Bl => (-self.hip_x_m, self.hip_y_m),
-            Leg::Br => (-self.hip_x_m, -self.hip_y_m),
-        }
+        self.hips.offset_m(leg)
     }
 
     /// `leg`'s hip in the ground frame for the body at `body`.

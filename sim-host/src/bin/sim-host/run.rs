@@ -121,10 +121,12 @@ pub(crate) struct RunArgs {
     /// The robot's MJCF (a scene is built around it) instead of the shipped model.
     #[arg(long)]
     pub(crate) model: Option<PathBuf>,
-    /// Operator command at a time, `SECONDS:MODE` with MODE one of the report's keys W S A L K X
-    /// or `stand` / `fold`; repeat for a sequence. Without it no teleop node is on the bus and
+    /// Operator command at a time, `SECONDS:MODE[,speed=M_S][,yaw=RAD_S]` with MODE one of the
+    /// report's keys W S A L K X, `stand`, `fold`, or `drive` / `walk` (at `speed`); `yaw`
+    /// steers W S L K drive walk (+ left); repeat for a sequence, e.g. `--drive 0:fold --drive
+    /// 4:drive,speed=0.3,yaw=0.3`. Without it no teleop node is on the bus and
     /// the controller holds the robot where it stands.
-    #[arg(long = "drive", value_parser = parse_step)]
+    #[arg(long = "drive", value_parser = teleop_core::scenario::parse_drive_step)]
     pub(crate) drive: Vec<PlanStep>,
     /// Control rate, Hz (the model's timestep must divide the period).
     #[arg(long, default_value_t = 250)]
@@ -195,22 +197,6 @@ pub(crate) struct RunArgs {
     /// `Imu`, `LegDrive_FL`, …). SYNC is never faulted.
     #[arg(long, value_name = "PLAN", default_value = "")]
     pub(crate) faults: Faults,
-}
-
-fn parse_step(text: &str) -> Result<PlanStep, String> {
-    let (time, mode) = text
-        .split_once(':')
-        .ok_or_else(|| format!("`{text}`: expected SECONDS:MODE, e.g. 2:W"))?;
-    let seconds: f64 = time
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{time}` is not a number of seconds"))?;
-    if !(0.0..=1e6).contains(&seconds) {
-        return Err(format!("`{time}`: time must be 0…1e6 s"));
-    }
-    let mode = teleop_core::scenario::parse_mode(mode)
-        .ok_or_else(|| format!("`{mode}`: use W S A L K X, stand or fold"))?;
-    Ok(PlanStep::at(seconds, mode))
 }
 
 /// A number within `range`, or a message naming the text and the range.

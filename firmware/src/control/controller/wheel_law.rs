@@ -1,0 +1,85 @@
+//! The wheels' law: the balance law on their common mode, the turn loop on their difference,
+//! and the runaway watch over both. What the state asks for becomes a speed reference (ground
+//! speed, m/s) and a turn reference (half the wheels' rate difference, rad/s).
+
+use super::{Controller, TURN_ACCEL_RAD_S2};
+use crate::control::fsm::{Direction, State, WheelMotion};
+use crate::control::steering::within;
+use crate::time::Tick;
+use crate::wheels::balance::BalanceInput;
+use crate::wheels::runaway::RunawayInput;
+use crate::wheels::wheel::mix;
+
+impl Controller {
+    /// This tick's wheel torques `[left, right]` from the balance law and the turn loop (none
+    /// while the attitude is unknown).
+    pub(super) fn wheel_law(&mut self, now: Tick, dt_s: f32) -> [f32; 2] {
+        if !self.sensors.attitude_known(now) {
+            return [0.0; 2];
+        }
+        self.set_trim_rules();
+        let (velocity_ref_m_s, turn_ref_rad_s) = self.wheel_references(now);
+        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        let common = self.balance.update(
+            &BalanceInput {
+                pitch_rad: self.sensors.attitude.pitch_rad,
+                pitch_rate_rad_s,
+                wheel_rate_rad_s: self.sensors.mean_wheel_rate_rad_s(),
+                velocity_ref_m_s,
+            },
+            dt_s,
+        );
+        if matches!(self.state, State::Wheels(_)) {
+            let input = RunawayInput {
+                ground_speed_m_s: self.ground_speed_m_s(),
+                velocity_ref_m_s: self.balance.velocity_ref_m_s(),
+                torque_nm: common,
+                torque_limit_nm: self.config.balance.torque_limit_nm,
+            };
+            if let Some(cause) = self.runaway.update(&self.config.runaway, &input) {
+                self.wheel_fault_stop(now, cause, input.ground_speed_m_s);
+            }
+        }
+        self.turn_ref_rad_s = crate::math::toward(
+            self.turn_ref_rad_s,
+            turn_ref_rad_s,
+            TURN_ACCEL_RAD_S2 * dt_s,
+        );
+        let differential = self.turn.update(
+            self.turn_ref_rad_s - self.sensors.differential_wheel_rate_rad_s(),
+            dt_s,
+        );
+        let (left, right) = mix(common, differential, self.config.wheel_torque_limit_nm);
+        [left, right]
+    }
+
+    /// The speed reference (m/s) and the turn reference (half the wheels' rate difference, left
+    /// minus right, rad/s) of the present state: the report's keys at the speed scale, steered
+    /// by the operator's yaw rate (not `A`, which turns on the spot at the scale); `Drive` at
+    /// the operator's speed and yaw rate; a fold's return to where it stood.
+    fn wheel_references(&self, now: Tick) -> (f32, f32) {
+        let config = &self.config;
+        let radius_m = config.balance.wheel_radius_m;
+        let preset_m_s = config.wheel_speed_rad_s * self.teleop.speed_scale * radius_m;
+        let steering = &config.steering;
+        let turn = |yaw_rad_s: f32| {
+            steering.differential_rate_rad_s(steering.wheel_yaw_rad_s(yaw_rad_s), radius_m)
+        };
+        let yaw_rad_s = self.teleop.yaw_rate_rad_s;
+        match self.state {
+            State::Wheels(WheelMotion::Drive(Direction::Forward)) => (preset_m_s, turn(yaw_rad_s)),
+            State::Wheels(WheelMotion::Drive(Direction::Backward)) => {
+                (-preset_m_s, turn(yaw_rad_s))
+            }
+            State::Wheels(WheelMotion::Rotate) => {
+                (0.0, config.wheel_speed_rad_s * self.teleop.speed_scale)
+            }
+            State::Wheels(WheelMotion::Velocity) => {
+                let top_m_s = config.wheel_speed_rad_s * radius_m;
+                (within(self.teleop.speed_m_s, top_m_s), turn(yaw_rad_s))
+            }
+            State::Folding(_) => (self.fold_return_m_s(now), 0.0),
+            _ => (0.0, 0.0),
+        }
+    }
+}
