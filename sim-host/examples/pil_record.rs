@@ -5,7 +5,8 @@
 //! The closed loop is the simulator's in-process one (MuJoCo, the emulated drives and IMU, a
 //! scripted operator), with the firmware's `Node` stepped here so that every frame it is given
 //! is written down with the tick it belongs to. The plan: stand, trot forward (L), then W —
-//! which folds the legs, catches the robot on its wheels and drives off balancing.
+//! which folds the legs, catches the robot on its wheels and drives off balancing — both
+//! steered left at 0.3 rad/s.
 //!
 //! Output: `pil-format`'s raw format (the one the PIL image reads).
 //!
@@ -48,8 +49,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let plan = vec![
         step(0.0, TeleopMode::Stand),
-        step(0.2, TeleopMode::TrotForward),
-        step(2.6, TeleopMode::WheelForward),
+        // Steered: the turning trot's strides and the wheels' curve are the dearer paths.
+        step(0.2, TeleopMode::TrotForward).with_velocity(0.0, 0.3),
+        step(2.6, TeleopMode::WheelForward).with_velocity(0.0, 0.3),
     ];
     let mut sim = Simulator::new(
         DEFAULT_MODEL.as_ref(),
