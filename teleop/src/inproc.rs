@@ -76,6 +76,7 @@ impl InprocRobot {
             segments: Vec::new(),
             frames: None,
             viewer: false,
+            live_port: None,
             attach: Some(attach),
             faults: Default::default(),
         };

@@ -59,7 +59,7 @@ pub fn run(
             started = Instant::now();
             continue;
         }
-        recorder.row(sim.telemetry())?;
+        recorder.cycle(sim)?;
         if !observe(sim, &stats) {
             break;
         }

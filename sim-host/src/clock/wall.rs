@@ -56,7 +56,7 @@ pub fn run(
         peers(sim.cycle())?;
         // No SYNC in real time: the bus (its fault layer) learns of the cycle here.
         bus.end_cycle()?;
-        recorder.row(sim.telemetry())?;
+        recorder.cycle(sim)?;
         if !observe(sim, &stats) {
             break;
         }

@@ -33,6 +33,14 @@ pub enum OutputError {
         /// What the plotting library said.
         message: String,
     },
+    /// The Foxglove SDK refused: the MCAP file (empty for the live server) and what it said.
+    #[error("Foxglove output {path}: {message}")]
+    Foxglove {
+        /// The MCAP file, or empty for the live server.
+        path: PathBuf,
+        /// What failed.
+        message: String,
+    },
     /// There are no telemetry rows, so there is nothing to plot.
     #[error("no telemetry rows were recorded, so there is nothing to plot")]
     NoRows,

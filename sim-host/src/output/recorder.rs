@@ -14,9 +14,11 @@ use std::time::{Duration, Instant};
 use protocol::Frame;
 
 use crate::output::decimated::Decimated;
+use crate::output::foxglove::FoxgloveLog;
 use crate::output::output_error::OutputError;
 use crate::output::telemetry::TelemetryRow;
 use crate::output::telemetry_csv::CsvWriter;
+use crate::session::simulator::Simulator;
 use host_can::candump::{CandumpWriter, LoggedFrame};
 
 /// Longest the logs stay in memory buffers before they are flushed to disk.
@@ -31,6 +33,7 @@ pub struct Recorder {
     last_flush: Option<Instant>,
     frames: u64,
     discard_rows: bool,
+    foxglove: Option<FoxgloveLog>,
 }
 
 impl Recorder {
@@ -76,9 +79,23 @@ impl Recorder {
         })
     }
 
+    /// Also logs to `foxglove` (an MCAP file, a live server).
+    pub fn set_foxglove(&mut self, foxglove: FoxgloveLog) {
+        self.last_flush.get_or_insert_with(Instant::now);
+        self.foxglove = Some(foxglove);
+    }
+
+    /// The Foxglove log, if there is one.
+    pub fn foxglove(&self) -> Option<&FoxgloveLog> {
+        self.foxglove.as_ref()
+    }
+
     /// Logs one frame seen on the bus at `time_s`.
     pub fn frame(&mut self, time_s: f64, frame: &Frame) -> Result<(), OutputError> {
         self.frames += 1;
+        if let Some(foxglove) = &mut self.foxglove {
+            foxglove.frame(time_s, frame);
+        }
         if let Some((path, writer)) = &mut self.candump {
             writer
                 .write(&LoggedFrame {
@@ -91,6 +108,15 @@ impl Recorder {
                 })?;
         }
         Ok(())
+    }
+
+    /// Records the simulator's present step: its telemetry row ([`Recorder::row`]) and, with a
+    /// Foxglove log, the robot's transforms and joints.
+    pub fn cycle(&mut self, sim: &Simulator) -> Result<(), OutputError> {
+        if let Some(foxglove) = &mut self.foxglove {
+            foxglove.cycle(sim);
+        }
+        self.row(sim.telemetry())
     }
 
     /// Keeps one telemetry row in bounded memory, for the plots (and writes it to the CSV file);
@@ -122,6 +148,9 @@ impl Recorder {
                 source,
             })?;
         }
+        if let Some(foxglove) = &mut self.foxglove {
+            foxglove.flush()?;
+        }
         self.last_flush = Some(Instant::now());
         Ok(())
     }
@@ -146,6 +175,9 @@ impl Recorder {
             writer
                 .finish()
                 .map_err(|source| OutputError::Io { path, source })?;
+        }
+        if let Some(foxglove) = self.foxglove {
+            foxglove.finish()?;
         }
         Ok(self.rows.into_vec())
     }

@@ -81,6 +81,9 @@ pub struct SessionConfig {
     /// Open the MuJoCo viewer, synced every cycle, and keep it open after the run until it is
     /// closed (closing it early ends the run). Without the `viewer` feature, `true` is an error.
     pub viewer: bool,
+    /// Serve the run live to Foxglove on this WebSocket port of 127.0.0.1 (`None`: no server; 0:
+    /// any free port, logged). The output folder gets `run.mcap` with the same topics.
+    pub live_port: Option<u16>,
     /// Someone outside the session on the in-process bus (the interactive teleop), or `None`.
     pub attach: Option<Attach>,
     /// Faults on the simulator's bus connection: `tx` breaks the feedback it sends, `rx` the

@@ -15,6 +15,7 @@ use teleop_core::scripted::ScriptedTeleop;
 
 use crate::clock::lockstep::{self, LockstepOptions};
 use crate::clock::wall::{self, WallOptions};
+use crate::output::foxglove::{FoxgloveLog, FoxgloveOutputs};
 use crate::output::metrics::{BusCounters, SegmentSummary};
 use crate::output::output_error::OutputError;
 use crate::output::recorder::Recorder;
@@ -67,6 +68,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         .max(0.0) as u64;
     let mut files = Vec::new();
     let mut recorder = open_recorder(config, &mut files)?;
+    open_foxglove(config, &sim, &mut recorder, &mut files)?;
     let counters: FirmwareCounters = Rc::new(Cell::new(Default::default()));
     let watch = Watch::open(config, &sim)?;
     let mut observer = Observer {
@@ -147,6 +149,40 @@ fn open_recorder(
         None if config.attach.is_some() => Recorder::discarding(),
         None => Recorder::in_memory(),
     })
+}
+
+/// The Foxglove outputs `config` asks for: `run.mcap` and `robot.urdf` in the output folder,
+/// and the live server.
+fn open_foxglove(
+    config: &SessionConfig,
+    sim: &Simulator,
+    recorder: &mut Recorder,
+    files: &mut Vec<PathBuf>,
+) -> Result<(), SessionError> {
+    let outputs = FoxgloveOutputs {
+        mcap: config.out_dir.as_ref().map(|dir| dir.join("run.mcap")),
+        live_port: config.live_port,
+    };
+    let Some(log) = FoxgloveLog::open(sim, &outputs)? else {
+        return Ok(());
+    };
+    if let Some(dir) = &config.out_dir {
+        let urdf = dir.join("robot.urdf");
+        std::fs::write(&urdf, log.urdf()).map_err(|source| OutputError::Io {
+            path: urdf.clone(),
+            source,
+        })?;
+        files.extend(outputs.mcap);
+        files.push(urdf);
+    }
+    if let Some(port) = log.live_port() {
+        tracing::info!(
+            port,
+            "Foxglove: open ws://127.0.0.1:{port} in the Foxglove app"
+        );
+    }
+    recorder.set_foxglove(log);
+    Ok(())
 }
 
 /// The plots, after the run (the logs were written as it went).

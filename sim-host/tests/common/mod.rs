@@ -45,6 +45,7 @@ pub fn config(
         segments,
         frames: None,
         viewer: false,
+        live_port: None,
     }
 }
 

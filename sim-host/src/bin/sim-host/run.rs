@@ -185,6 +185,11 @@ pub(crate) struct RunArgs {
     /// `--clock wall` (lockstep plays faster than real time). Build with `--features viewer`.
     #[arg(long)]
     pub(crate) viewer: bool,
+    /// Serve the run live to the Foxglove app on this WebSocket port of 127.0.0.1 (0: any free
+    /// port; the log says which). Best with `--pace 1`. The output folder gets the same topics
+    /// in run.mcap either way.
+    #[arg(long, value_name = "PORT")]
+    pub(crate) foxglove_port: Option<u16>,
     /// Render the model's `chase` camera to <out>/frames/frame_00000.png, … at the start and
     /// every N control cycles (25 at 250 Hz: 10 frames per simulated second). Headless, through
     /// EGL (Mesa: libegl1 libegl-mesa0 libgl1-mesa-dri). Build with `--features renderer`.
@@ -381,6 +386,7 @@ fn session_config(
             every_cycles,
         }),
         viewer: args.viewer,
+        live_port: args.foxglove_port,
         stop: Some(stop_on_ctrl_c()),
         segments,
     }
