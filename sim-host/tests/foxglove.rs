@@ -111,8 +111,23 @@ fn the_mcap_opens_in_an_independent_reader_with_every_channel_and_mujocos_torso_
     assert!(status.abs_diff(cycles / 5) <= 2, "{status}");
     assert!(expect("/controller/log", "foxglove.Log", "protobuf") >= 3);
     assert!(expect("/can", "CanFrame", "json") > 8 * cycles);
-    assert!(expect("/robot_description", "String", "json") >= 4);
+    assert!(expect("/robot_description", "std_msgs/String", "json") >= 4);
     assert_eq!(read["attachments"], serde_json::json!(["robot.urdf"]));
+    // The documented layout shows only topics the log has.
+    let layout = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/foxglove/layout.json"),
+    )
+    .unwrap();
+    let layout: serde_json::Value = serde_json::from_str(&layout).unwrap();
+    let mut named = Vec::new();
+    topics_in(&layout, &mut named);
+    assert!(named.len() >= 8, "{named:?}");
+    for topic in named {
+        assert!(
+            channels.contains_key(&topic),
+            "the layout shows {topic}, the log has no such topic"
+        );
+    }
 
     // Every torso transform is MuJoCo's torso pose of that cycle, as the run sampled it.
     let torso = read["torso"].as_array().unwrap();
@@ -138,6 +153,19 @@ fn the_mcap_opens_in_an_independent_reader_with_every_channel_and_mujocos_torso_
         worst_m < 1e-3 && worst_deg < 0.01,
         "{worst_m} m, {worst_deg} deg"
     );
+}
+
+/// The topics a layout's panels name: the part of every `/…` string value before a field path.
+fn topics_in(value: &serde_json::Value, out: &mut Vec<String>) {
+    match value {
+        serde_json::Value::String(s) if s.starts_with('/') => {
+            let end = s.find(['.', '[']).unwrap_or(s.len());
+            out.push(s[..end].to_owned());
+        }
+        serde_json::Value::Array(items) => items.iter().for_each(|v| topics_in(v, out)),
+        serde_json::Value::Object(map) => map.values().for_each(|v| topics_in(v, out)),
+        _ => {}
+    }
 }
 
 #[test]

@@ -71,6 +71,8 @@ fn frames_of_the_standing_robot_show_the_scene_at_the_configured_size() {
     let dir = scratch("frames");
     let mut options = FrameOptions::chase(&dir, every);
     options.size_px = Some((320, 240));
+    let gif_path = dir.join("run.gif");
+    options.animation = Some((gif_path.clone(), 10));
     let mut frames = match FrameRenderer::new(model, options) {
         Ok(frames) => frames,
         Err(e) => panic!("{e}"),
@@ -120,9 +122,32 @@ fn frames_of_the_standing_robot_show_the_scene_at_the_configured_size() {
     // The in-memory frame is the last file's pixels.
     assert_eq!(frames.rgb(), decode(&written[3]).2.as_slice());
 
+    // The animation: the same frames, halved, each 0.1 s, the torso in view in each.
+    assert_eq!(frames.finish().unwrap(), written);
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let mut decoder = options
+        .read_info(std::fs::File::open(&gif_path).unwrap())
+        .unwrap();
+    assert_eq!((decoder.width(), decoder.height()), (160, 120));
+    let mut shown = 0;
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        assert_eq!(frame.delay, 10);
+        let blue = frame
+            .buffer
+            .chunks_exact(4)
+            .filter(|p| torso_blue(p))
+            .count();
+        assert!(
+            blue > 160 * 120 / 100,
+            "GIF frame {shown}: {blue} torso-blue pixels"
+        );
+        shown += 1;
+    }
+    assert_eq!(shown, 4);
+
     // Full size from the model's offscreen buffer (640 x 480).
     let full_dir = scratch("full");
-    drop(frames);
     let mut full =
         FrameRenderer::new(sim.physics().model(), FrameOptions::chase(&full_dir, every)).unwrap();
     let path = full.render(sim.physics()).unwrap();

@@ -24,7 +24,7 @@ fn a_bad_scenario_file_names_its_line_and_exits_2() {
     let text = stderr(&out);
     assert!(text.contains("bad_teleop_script.toml:4:"), "{text}");
     assert!(
-        text.contains("use W, S, A, L, K, X, stand or fold"),
+        text.contains("use W, S, A, L, K, X, stand, fold, drive or walk"),
         "{text}"
     );
 

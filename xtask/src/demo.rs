@@ -2,8 +2,9 @@
 //! demonstration, closed loop. Sets up (MuJoCo, targets, Mesa), builds `sim-host` in release
 //! with the headless renderer, and runs `scenarios/report_demo.toml` — STOP, W, S, A, L, K, X —
 //! with the firmware's control core on the in-process CAN bus (or over SocketCAN with `--bus`).
-//! Leaves `summary.json`, `telemetry.csv`, `bus.log` (candump), the plots and a few rendered
-//! frames in `out/` and prints a table of the segments.
+//! Leaves `summary.json`, `telemetry.csv`, `bus.log` (candump), `run.mcap` and `robot.urdf`
+//! (Foxglove), the plots, a few rendered frames and their animation `run.gif` in `out/` and
+//! prints a table of the segments.
 //!
 //! `cargo xtask demo --teleop` instead opens teleop's terminal UI on the simulated robot: the
 //! simulator and the firmware run in the teleop process on the in-process bus, so anyone can
@@ -68,9 +69,9 @@ pub fn run(args: &[String]) -> Result<(), String> {
     }
     sh(&mut cmd)?;
     eprintln!(
-        "demo: outputs in {} (summary.json, telemetry.csv, bus.log, *.png{})",
+        "demo: outputs in {} (summary.json, telemetry.csv, bus.log, run.mcap, robot.urdf, *.png{})",
         out.display(),
-        if render { ", frames/" } else { "" }
+        if render { ", frames/, run.gif" } else { "" }
     );
     Ok(())
 }

@@ -130,7 +130,7 @@ fn parse(args: &[String]) -> Result<Request, String> {
             "--speed-pct" => speed_pct = number("--speed-pct", &value("--speed-pct")?)?,
             other if kind == "command" && mode.is_none() && !other.starts_with("--") => {
                 mode = Some(teleop_core::scenario::parse_mode(other).ok_or_else(|| {
-                    format!("unknown mode `{other}`: use W S A L K X, stand or fold")
+                    format!("unknown mode `{other}`: use W S A L K X, stand, fold, drive or walk")
                 })?);
             }
             other => return Err(format!("unknown option `{other}`\n{USAGE}")),

@@ -1,10 +1,11 @@
 //! What a run leaves for its user: the [`telemetry`] rows and their [`telemetry_csv`] file, the
 //! [`recorder`] that streams the bus to a candump log, the figures per segment ([`metrics`],
 //! [`summary`], the obstacles' [`crossings`]), the [`plots`], rendered frames ([`render`],
-//! feature `renderer`), the [`foxglove`] MCAP log and live server, and the interactive
+//! feature `renderer`) and their [`animation`], the [`foxglove`] MCAP log and live server, and the interactive
 //! [`viewer`] (feature `viewer`); [`output_error`]
 //! names the file that failed.
 
+pub mod animation;
 pub mod crossings;
 pub mod decimated;
 pub mod foxglove;

@@ -20,6 +20,7 @@ use mujoco_rs::error::MjDataError;
 use mujoco_rs::prelude::{MjData, MjModel, MjtObjBase, MjvCamera};
 use mujoco_rs::renderer::{png, MjRenderer, RendererError};
 
+use crate::output::animation::Animation;
 use crate::robot::physics::Physics;
 use crate::session::simulator::Simulator;
 
@@ -45,6 +46,9 @@ pub struct FrameOptions {
     /// (`<visual><global offwidth offheight>`, 640 × 480 in `hybrid_robot.xml`). Must fit in
     /// that buffer.
     pub size_px: Option<(u32, u32)>,
+    /// Also write every frame, halved, to this animated GIF, each shown this many hundredths of
+    /// a second (`None`: no animation).
+    pub animation: Option<(PathBuf, u16)>,
 }
 
 impl FrameOptions {
@@ -56,6 +60,7 @@ impl FrameOptions {
             every_cycles,
             camera: CHASE_CAMERA.to_owned(),
             size_px: None,
+            animation: None,
         }
     }
 }
@@ -120,6 +125,13 @@ pub enum RenderError {
         /// What mujoco-rs reported.
         source: RendererError,
     },
+    /// The animation could not be written.
+    #[error("{source}")]
+    Animation {
+        /// What failed, naming the file.
+        #[from]
+        source: crate::output::output_error::OutputError,
+    },
     /// The physics is not the model the renderer was made for.
     #[error("the renderer was made for another model: {source}")]
     OtherModel {
@@ -139,6 +151,7 @@ pub struct FrameRenderer {
     every_cycles: NonZeroU32,
     size_px: (u32, u32),
     frames: Vec<PathBuf>,
+    animation: Option<Animation>,
 }
 
 impl std::fmt::Debug for FrameRenderer {
@@ -195,7 +208,12 @@ impl FrameRenderer {
             .camera(MjvCamera::new_fixed(camera_id))
             .build(model)
             .map_err(|source| RenderError::Egl { source })?;
+        let animation = match &options.animation {
+            Some((path, delay_cs)) => Some(Animation::create(path, (width, height), *delay_cs)?),
+            None => None,
+        };
         Ok(Self {
+            animation,
             renderer,
             mirror: MjData::new(Box::new(model.clone())),
             dir: options.dir,
@@ -242,6 +260,10 @@ impl FrameRenderer {
                 source,
             })?;
         self.frames.push(path.clone());
+        if let Some(animation) = &mut self.animation {
+            let rgb = self.renderer.rgb_flat().unwrap_or(&[]);
+            animation.push(rgb)?;
+        }
         Ok(path)
     }
 
@@ -266,8 +288,15 @@ impl FrameRenderer {
         &self.frames
     }
 
-    /// The files written, giving the renderer up (its OpenGL context is freed).
-    pub fn into_frames(self) -> Vec<PathBuf> {
-        self.frames
+    /// The files written, giving the renderer up (its OpenGL context is freed) and ending the
+    /// animation.
+    ///
+    /// # Errors
+    /// [`RenderError::Animation`] when the animation's file cannot be completed.
+    pub fn finish(self) -> Result<Vec<PathBuf>, RenderError> {
+        if let Some(animation) = self.animation {
+            animation.finish()?;
+        }
+        Ok(self.frames)
     }
 }

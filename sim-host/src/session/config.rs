@@ -42,6 +42,15 @@ pub struct FrameSettings {
     pub every_cycles: NonZeroU32,
 }
 
+impl FrameSettings {
+    /// The run's animation: `run.gif` beside the frames' folder.
+    pub fn animation_path(&self) -> PathBuf {
+        self.dir
+            .parent()
+            .map_or_else(|| PathBuf::from("run.gif"), |dir| dir.join("run.gif"))
+    }
+}
+
 /// Everything a run needs.
 #[derive(Debug, Clone)]
 pub struct SessionConfig {

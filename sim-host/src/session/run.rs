@@ -106,6 +106,9 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         return Err(e);
     }
     let frames = observer.watch.finish()?;
+    if let Some(settings) = config.frames.as_ref().filter(|_| !frames.is_empty()) {
+        files.push(settings.animation_path());
+    }
     let drives_rejected = sim.hardware().rejected();
     let drives_clamped = sim.hardware().clamped();
     let rows = recorder.finish()?;

@@ -7,6 +7,15 @@ use crate::session::config::SessionConfig;
 use crate::session::error::SessionError;
 use crate::session::simulator::Simulator;
 
+/// The animation plays at twice the simulation's speed: each frame shows half the simulated time
+/// between two frames, hundredths of a second (at least 2: browsers slow faster GIFs down).
+#[cfg(feature = "renderer")]
+fn animation_delay_cs(config: &SessionConfig) -> u16 {
+    let every = config.frames.as_ref().map_or(1, |f| f.every_cycles.get());
+    let seconds = f64::from(every) / f64::from(config.control_hz.max(1));
+    (seconds * 100.0 / 2.0).round().clamp(2.0, 6000.0) as u16
+}
+
 /// What watches a run besides the progress bar: frames (feature `renderer`) and the viewer
 /// (feature `viewer`).
 #[derive(Debug, Default)]
@@ -25,8 +34,9 @@ impl Watch {
         if let Some(frames) = &config.frames {
             #[cfg(feature = "renderer")]
             {
-                let options =
+                let mut options =
                     crate::output::render::FrameOptions::chase(&frames.dir, frames.every_cycles);
+                options.animation = Some((frames.animation_path(), animation_delay_cs(config)));
                 let mut renderer =
                     crate::output::render::FrameRenderer::new(sim.physics().model(), options)?;
                 renderer.render(sim.physics())?;
@@ -82,7 +92,7 @@ impl Watch {
         }
         #[cfg(feature = "renderer")]
         if let Some(frames) = self.frames {
-            return Ok(frames.into_frames());
+            return Ok(frames.finish()?);
         }
         Ok(Vec::new())
     }

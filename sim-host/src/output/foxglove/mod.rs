@@ -10,7 +10,7 @@
 //! | `/controller/status` | JSON `ControllerStatus` | the controller's mode, faults, pitch, roll, body height |
 //! | `/controller/log` | `foxglove.Log` | a line per change of mode or fault flags |
 //! | `/can` | JSON `CanFrame` | every frame on the bus: id, message name, data |
-//! | `/robot_description` | JSON `String` | the URDF (also attached to the MCAP, and `robot.urdf` beside it) |
+//! | `/robot_description` | JSON `std_msgs/String` | the URDF (also attached to the MCAP, and `robot.urdf` beside it) |
 //!
 //! Log times are simulation time. The MCAP is lz4-chunked and flushed with the other logs (at
 //! least once a second), so a killed run leaves it readable up to its last flush (MCAP readers
@@ -343,7 +343,7 @@ impl Channels {
             )?,
             description: json(
                 "/robot_description",
-                "String",
+                "std_msgs/String",
                 json!({"data": {"type": "string"}}),
             )?,
         })
