@@ -89,6 +89,20 @@ impl App {
         }
     }
 
+    /// Takes a gamepad's action at `now_ms` ([`teleop_core::gamepad`]).
+    pub fn pad(&mut self, now_ms: u64, act: Action) {
+        self.operator.press(now_ms, act);
+        match act {
+            Action::EStop => self.note("E-STOP latched (pad): press Start twice to release".into()),
+            Action::InputLost => {
+                self.note("gamepad lost: the robot was told to stop; X, then a motion".into())
+            }
+            Action::InputFound => self.note("gamepad back: X, then a motion".into()),
+            Action::Mode(mode) => self.note(format!("command {} (pad)", mode_text(mode))),
+            _ => {}
+        }
+    }
+
     /// The frames due at `now_ms` (send them on the bus).
     pub fn poll(&mut self, now_ms: u64) -> Result<Vec<Frame>, EncodeError> {
         let frames = self.operator.poll(now_ms)?;

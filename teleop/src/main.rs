@@ -47,6 +47,11 @@ struct Cli {
     /// firmware-host's). Without it, the public test key of simulation and CI.
     #[arg(long, value_name = "PATH")]
     key_file: Option<PathBuf>,
+    /// Also drive with a gamepad (sticks: speed and yaw rate; A drive, Y walk, X stop, B
+    /// E-stop, Start twice release, shoulders fold / stand, D-pad height): the first one found,
+    /// or the evdev device named (/dev/input/eventN). `teleop pad` uses it without a screen.
+    #[arg(long, value_name = "DEVICE", num_args = 0..=1, default_missing_value = "auto")]
+    gamepad: Option<String>,
     #[command(subcommand)]
     command: Option<Command>,
 }
@@ -60,6 +65,12 @@ enum Command {
         key: Action,
         /// Seconds to keep sending the command and heartbeat.
         #[arg(long = "for", default_value_t = 1.0)]
+        seconds: f64,
+    },
+    /// Drive with a gamepad without a screen (for scripts and tests), for a while.
+    Pad {
+        /// Seconds to keep reading the pad and sending.
+        #[arg(long = "for", default_value_t = 60.0)]
         seconds: f64,
     },
     /// Follow a scenario file (TOML: steps of `at_s` and `mode`, as sim-host reads) on the
@@ -127,7 +138,7 @@ fn run(cli: Cli) -> Result<(), Failure> {
         Some(Command::Script { file }) => {
             Some(Scenario::load(file).map_err(|e| Failure::usage(e.to_string()))?)
         }
-        Some(Command::Send { seconds, .. })
+        Some(Command::Send { seconds, .. } | Command::Pad { seconds })
             if !(seconds.is_finite() && (0.0..=86_400.0).contains(seconds)) =>
         {
             return Err(Failure::usage(format!(
@@ -171,9 +182,10 @@ fn operate(
     stop: &AtomicBool,
     live: &mut dyn FnMut() -> Option<teleop::app::SimView>,
 ) -> Result<(), Failure> {
+    let mut pad = open_pad(cli)?;
     let report = match (&cli.command, scenario) {
         (None, _) => {
-            let report = teleop::terminal::run(bus, &cli.bus, key, live, stop)
+            let report = teleop::terminal::run(bus, &cli.bus, key, live, pad.as_mut(), stop)
                 .map_err(|e| Failure::bus(e.to_string()))?;
             println!(
                 "teleop: sent {} frames on {}; the robot was told to stop{}",
@@ -194,6 +206,26 @@ fn operate(
             }),
             _,
         ) => script::send(bus, key, *action, Duration::from_secs_f64(*seconds), stop),
+        (Some(Command::Pad { seconds }), _) => {
+            let Some(reader) = pad.as_mut() else {
+                return Err(Failure::usage("no gamepad was opened".into()));
+            };
+            println!(
+                "teleop: gamepad {} on {} for {seconds:.1} s",
+                reader
+                    .device()
+                    .map_or("?".into(), |p| p.display().to_string()),
+                cli.bus
+            );
+            script::pad(
+                bus,
+                key,
+                reader,
+                Duration::from_secs_f64(*seconds),
+                stop,
+                |now_ms, action| println!("  t = {:6.3} s  {action:?}", now_ms as f64 / 1e3),
+            )
+        }
         (Some(Command::Script { .. }), Some(scenario)) => {
             println!(
                 "teleop: script `{}`, {} steps over {:.1} s on {}",
@@ -219,6 +251,22 @@ fn operate(
     }
     .map_err(Failure::bus)?;
     conclude(&report, &cli.bus)
+}
+
+/// The gamepad `--gamepad` names (or `teleop pad` wants), opened; `None` without one.
+fn open_pad(cli: &Cli) -> Result<Option<teleop::gamepad::PadReader>, Failure> {
+    let wanted = match (&cli.gamepad, &cli.command) {
+        (Some(device), _) => Some(device.as_str()),
+        (None, Some(Command::Pad { .. })) => Some("auto"),
+        (None, _) => None,
+    };
+    let Some(wanted) = wanted else {
+        return Ok(None);
+    };
+    let path = (wanted != "auto").then(|| PathBuf::from(wanted));
+    teleop::gamepad::PadReader::open(path.as_deref())
+        .map(Some)
+        .map_err(|e| Failure::bus(e.to_string()))
 }
 
 fn conclude(report: &ScriptReport, bus: &str) -> Result<(), Failure> {

@@ -1,6 +1,6 @@
 //! Scripted operation for shells and automation, on the wall clock: `teleop send KEY --for S`
-//! holds one key, `teleop script FILE.toml` follows a scenario file (the format sim-host reads).
-//! Both send the command and the heartbeat at 50 Hz like the interactive operator, listen to
+//! holds one key, `teleop script FILE.toml` follows a scenario file (the format sim-host reads),
+//! `teleop pad --for S` follows a gamepad without a screen. All send the command and the heartbeat at 50 Hz like the interactive operator, listen to
 //! the bus while they do, and end by going silent: the controller's operator watchdog then
 //! stops the robot within 500 ms.
 
@@ -109,6 +109,29 @@ pub fn run(
             started += 1;
         }
         teleop.frames(now_us)
+    })
+}
+
+/// Follows the gamepad `reader` for `hold` (or until `stop`); `on_action` is told each action
+/// as it is taken, with the milliseconds since the start.
+pub fn pad(
+    bus: &mut dyn Bus,
+    bus_key: protocol::Key,
+    reader: &mut crate::gamepad::PadReader,
+    hold: Duration,
+    stop: &AtomicBool,
+    mut on_action: impl FnMut(u64, &Action),
+) -> Result<ScriptReport, ScriptError> {
+    let mut operator = Operator::with_link(OperatorLink::new(bus_key));
+    serve(bus, hold, stop, |now_ms, heard| {
+        for frame in heard {
+            operator.observe(frame);
+        }
+        for action in reader.poll(Instant::now()) {
+            on_action(now_ms, &action);
+            operator.press(now_ms, action);
+        }
+        operator.poll(now_ms)
     })
 }
 

@@ -1,4 +1,4 @@
-//! The interactive loop: crossterm keys in, the operator's frames out on the bus, the bus heard
+//! The interactive loop: crossterm keys (and a gamepad's actions) in, the operator's frames out on the bus, the bus heard
 //! and drawn with ratatui. It polls without blocking so that the 50 Hz heartbeat never waits on
 //! the keyboard or the screen. On quit it sends a STOP command before it goes silent.
 
@@ -10,6 +10,7 @@ use ratatui::crossterm::event::{self, Event, KeyCode, KeyEventKind, KeyModifiers
 use teleop_core::keys::Key;
 
 use crate::app::{App, SimView};
+use crate::gamepad::PadReader;
 
 /// Screen refresh period.
 const DRAW_PERIOD: Duration = Duration::from_millis(50);
@@ -45,10 +46,11 @@ pub fn run(
     bus_name: &str,
     key: protocol::Key,
     mut live: impl FnMut() -> Option<SimView>,
+    pad: Option<&mut PadReader>,
     stop: &AtomicBool,
 ) -> Result<TerminalReport, TerminalError> {
     let mut terminal = ratatui::try_init()?;
-    let result = serve(&mut terminal, bus, (bus_name, key), &mut live, stop);
+    let result = serve(&mut terminal, bus, (bus_name, key), &mut live, pad, stop);
     ratatui::try_restore()?;
     result
 }
@@ -58,6 +60,7 @@ fn serve(
     bus: &mut dyn Bus,
     (bus_name, key): (&str, protocol::Key),
     live: &mut dyn FnMut() -> Option<SimView>,
+    mut pad: Option<&mut PadReader>,
     stop: &AtomicBool,
 ) -> Result<TerminalReport, TerminalError> {
     let start = Instant::now();
@@ -69,6 +72,11 @@ fn serve(
         while event::poll(Duration::ZERO)? {
             if let Some(key) = key_of(event::read()?) {
                 app.key(now_ms(), key);
+            }
+        }
+        if let Some(pad) = pad.as_deref_mut() {
+            for action in pad.poll(Instant::now()) {
+                app.pad(now_ms(), action);
             }
         }
         let now = now_ms();

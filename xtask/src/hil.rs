@@ -4,7 +4,7 @@
 //! Where this machine can make `vcan` interfaces (root or CAP_NET_ADMIN, the `vcan` module),
 //! the suite runs natively. Otherwise it boots a throwaway QEMU VM (`-accel tcg`) with a stock
 //! Debian kernel from apt and an initramfs holding busybox, the kernel's `can`, `can-raw`,
-//! `can-dev` and `vcan` modules (loaded in that order), iproute2, can-utils, the project's
+//! `can-dev` and `vcan` modules (loaded in that order), `evdev` and `uinput` (a virtual gamepad), iproute2, can-utils, the project's
 //! binaries and test binary with their shared libraries (libmujoco too), the models and the
 //! scenarios; runs the suite inside, prints it on the console and exits with its status.
 //! Everything comes from apt and is cached in `.cache/hil/`.
@@ -24,7 +24,7 @@ const PACKAGES: [&str; 5] = [
     "iproute2",
 ];
 /// The kernel modules, in load order.
-const MODULES: [&str; 5] = [
+const MODULES: [&str; 7] = [
     "net/can/can.ko",
     "net/can/can-raw.ko",
     "drivers/net/can/dev/can-dev.ko",
@@ -32,6 +32,9 @@ const MODULES: [&str; 5] = [
     // A token-bucket qdisc starves a vcan's transmit queue (`ENOBUFS`), as a bus-off or an
     // overloaded controller does.
     "net/sched/sch_tbf.ko",
+    // Input devices: a virtual gamepad (uinput) read as teleop reads a real one (evdev).
+    "drivers/input/evdev.ko",
+    "drivers/input/misc/uinput.ko",
 ];
 /// Programs copied into the VM from the host's PATH.
 const TOOLS: [&str; 5] = ["ip", "tc", "candump", "cansend", "canplayer"];

@@ -43,6 +43,18 @@ pub enum Action {
     Speed(f32),
     /// Change the yaw rate that steers the moving keys by this much, rad/s (+ left).
     Steer(f32),
+    /// A gamepad's sticks: forward speed and left turn as fractions of the mode's limits
+    /// (−1…1; see [`crate::gamepad`]).
+    Sticks {
+        /// Forward, + ahead.
+        forward: f32,
+        /// Turn, + left.
+        turn: f32,
+    },
+    /// The input device went away: stop, then fall silent (an operator lost).
+    InputLost,
+    /// The input device is back.
+    InputFound,
     /// Latch the E-stop.
     EStop,
     /// One press of the release sequence.

@@ -6,8 +6,8 @@
 //! `R` twice within 2 s, so that no single stray key does it.
 
 use protocol::{
-    AnyMessage, BodyHeight, ControllerMode, EStop, EStopAction, EncodeError, Frame, Millis, NodeId,
-    SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, YawRate, TEST_KEY,
+    AnyMessage, BodyHeight, ControllerMode, EStop, EStopAction, EncodeError, Frame, GroundSpeed,
+    Millis, NodeId, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, YawRate, TEST_KEY,
 };
 
 use crate::keys::Action;
@@ -28,6 +28,15 @@ pub const LATCH_REPEAT_MS: u64 = 4;
 pub const RELEASE_WINDOW_MS: u64 = 2_000;
 /// Body-height range of the wire, m.
 pub const BODY_HEIGHT_RANGE_M: (f32, f32) = (-0.10, 0.12);
+/// A gamepad's full stick in `drive`: the controller's limits on the wheels (W's full speed,
+/// m/s, and its yaw-rate limit, rad/s).
+pub const DRIVE_LIMITS: (f32, f32) = (0.48, 1.0);
+/// A gamepad's full stick in `walk`: the trot's full stride, m/s, and its yaw-rate limit, rad/s.
+pub const WALK_LIMITS: (f32, f32) = (0.145, 0.4);
+/// A moving stick sends its command at most this often, ms (a mode change goes at once): the
+/// controller takes two operator commands per control tick.
+pub const STICK_PERIOD_MS: u64 = 10;
+
 /// The keys' steering range, rad/s: the controller's own limits are tighter on the legs
 /// (0.4 rad/s) and take what it can.
 pub const STEER_RANGE_RAD_S: f32 = 1.0;
@@ -49,6 +58,17 @@ pub struct Operator {
     speed_scale_pct: f32,
     /// Yaw rate that steers the moving keys, rad/s, + left.
     yaw_rate_rad_s: f32,
+    /// A gamepad's sticks, forward and left turn, fractions of the mode's limits.
+    sticks: (f32, f32),
+    /// Whether the sticks moved since the last command.
+    sticks_changed: bool,
+    /// When the last command went out.
+    last_command_ms: Option<u64>,
+    /// Whether the input device is gone: nothing but an E-stop goes out (after the STOP that
+    /// says so), as if the operator had left.
+    silent: bool,
+    /// Falls silent once the pending command (the STOP) is out.
+    silence_after_command: bool,
     estop_latched: bool,
     /// Whether the controller has reported its E-stop since this operator's last latch.
     estop_confirmed: bool,
@@ -82,6 +102,11 @@ impl Operator {
             body_height_m: 0.0,
             speed_scale_pct: 100.0,
             yaw_rate_rad_s: 0.0,
+            sticks: (0.0, 0.0),
+            sticks_changed: false,
+            last_command_ms: None,
+            silent: false,
+            silence_after_command: false,
             estop_latched: false,
             estop_confirmed: false,
             latch_sent_ms: None,
@@ -152,6 +177,28 @@ impl Operator {
         self.yaw_rate_rad_s
     }
 
+    /// The ground speed (m/s) and yaw rate (rad/s, + left) the command carries now: the sticks
+    /// within the mode's limits in `drive` and `walk`, plus the keys' steering.
+    pub fn velocity(&self) -> (f32, f32) {
+        let (forward, turn) = self.sticks;
+        let limits = match self.mode {
+            TeleopMode::Drive => Some(DRIVE_LIMITS),
+            TeleopMode::Walk => Some(WALK_LIMITS),
+            _ => None,
+        };
+        match limits {
+            Some((speed_m_s, yaw_rad_s)) => {
+                (forward * speed_m_s, turn * yaw_rad_s + self.yaw_rate_rad_s)
+            }
+            None => (0.0, self.yaw_rate_rad_s),
+        }
+    }
+
+    /// Whether the input device is gone and the operator silent.
+    pub fn silent(&self) -> bool {
+        self.silent
+    }
+
     /// Whether this operator latched an E-stop that is not yet released.
     pub fn estop_latched(&self) -> bool {
         self.estop_latched
@@ -180,10 +227,28 @@ impl Operator {
 
     /// Takes one key action at `now_ms`.
     pub fn press(&mut self, now_ms: u64, action: Action) -> Outcome {
-        if action != Action::Release {
+        if !matches!(action, Action::Release | Action::Sticks { .. }) {
             self.release_armed_at_ms = None;
         }
+        if !matches!(action, Action::Sticks { .. } | Action::InputLost) {
+            // Someone is at the controls.
+            self.silent = false;
+            self.silence_after_command = false;
+        }
         match action {
+            Action::Sticks { forward, turn } => {
+                let before = self.wire_velocity();
+                self.sticks = (clamp_unit(forward), clamp_unit(turn));
+                self.sticks_changed |= self.wire_velocity() != before;
+            }
+            Action::InputLost => {
+                self.mode = TeleopMode::Stop;
+                self.sticks = (0.0, 0.0);
+                self.yaw_rate_rad_s = 0.0;
+                self.command_changed = true;
+                self.silence_after_command = true;
+            }
+            Action::InputFound => {}
             Action::Mode(mode) => {
                 // Every motion starts straight.
                 self.command_changed |= mode != self.mode || self.yaw_rate_rad_s != 0.0;
@@ -272,19 +337,33 @@ impl Operator {
                 frames.push(frame);
             }
         }
+        if self.silent {
+            return Ok(frames);
+        }
         let periodic = now_ms >= self.next_send_ms;
-        if self.command_changed || periodic {
+        let sticks_due = self.sticks_changed
+            && self
+                .last_command_ms
+                .is_none_or(|at| now_ms.saturating_sub(at) >= STICK_PERIOD_MS);
+        if self.command_changed || periodic || sticks_due {
+            let (speed, yaw_rate) = self.wire_velocity();
             let command = AnyMessage::TeleopCommand(TeleopCommand {
                 mode: self.mode,
                 body_height: BodyHeight::saturating_from_si(self.body_height_m),
                 speed_scale: SpeedScale::saturating_from_si(self.speed_scale_pct),
-                speed: Default::default(),
-                yaw_rate: YawRate::saturating_from_si(self.yaw_rate_rad_s),
+                speed,
+                yaw_rate,
             });
             // Before the session is joined nothing goes out, and a change waits for it.
             if let Some(frame) = self.link.seal(&command)? {
                 frames.push(frame);
                 self.command_changed = false;
+                self.sticks_changed = false;
+                self.last_command_ms = Some(now_ms);
+                if std::mem::take(&mut self.silence_after_command) {
+                    self.silent = true;
+                    return Ok(frames);
+                }
             }
             if periodic {
                 self.next_send_ms = now_ms - now_ms % PERIOD_MS + PERIOD_MS;
@@ -306,3 +385,23 @@ impl Operator {
 
 #[cfg(test)]
 mod tests;
+
+impl Operator {
+    /// The velocity as the wire carries it (what decides whether a stick's move is news).
+    fn wire_velocity(&self) -> (GroundSpeed, YawRate) {
+        let (speed_m_s, yaw_rad_s) = self.velocity();
+        (
+            GroundSpeed::saturating_from_si(speed_m_s),
+            YawRate::saturating_from_si(yaw_rad_s),
+        )
+    }
+}
+
+/// `value` within −1…1 (0 for a non-finite one).
+fn clamp_unit(value: f32) -> f32 {
+    if value.is_finite() {
+        value.clamp(-1.0, 1.0)
+    } else {
+        0.0
+    }
+}

@@ -245,3 +245,97 @@ fn a_new_latch_or_a_new_session_drops_a_release_on_its_way() {
     let later: usize = (601..900).map(|t| releases(&op.poll(t).unwrap())).sum();
     assert_eq!(later, 0, "no release into a new session");
 }
+
+#[test]
+fn sticks_drive_at_the_modes_limits_and_a_moving_stick_sends_at_most_every_10_ms() {
+    let mut op = Operator::new();
+    let mut ctl = FakeController::new();
+    op.observe(&ctl.announce());
+    ctl.decode(&op.poll(0).unwrap());
+    op.press(1, Action::Mode(TeleopMode::Drive));
+    op.press(
+        1,
+        Action::Sticks {
+            forward: 0.5,
+            turn: -1.0,
+        },
+    );
+    let sent = ctl.decode(&op.poll(1).unwrap());
+    let [AnyMessage::TeleopCommand(command)] = sent.as_slice() else {
+        panic!("{sent:?}");
+    };
+    assert_eq!(command.mode, TeleopMode::Drive);
+    assert!((command.speed.si() - 0.24).abs() < 1e-3, "{command:?}");
+    assert!((command.yaw_rate.si() + 1.0).abs() < 1e-3, "{command:?}");
+    // A stick moving every ms: a command every 10 ms, the last position each time.
+    let mut commands = Vec::new();
+    for t in 2..12 {
+        op.press(
+            t,
+            Action::Sticks {
+                forward: t as f32 / 20.0,
+                turn: 0.0,
+            },
+        );
+        for message in ctl.decode(&op.poll(t).unwrap()) {
+            if let AnyMessage::TeleopCommand(c) = message {
+                commands.push((t, c.speed.si()));
+            }
+        }
+    }
+    assert_eq!(commands.len(), 1, "{commands:?}");
+    assert_eq!(commands[0].0, 11);
+    assert!((commands[0].1 - 11.0 / 20.0 * 0.48).abs() < 1e-3);
+    // In walk the same stick asks for the trot's limits; in the report's keys, no speed.
+    op.press(12, Action::Mode(TeleopMode::Walk));
+    assert!((op.velocity().0 - 11.0 / 20.0 * 0.145).abs() < 1e-6);
+    op.press(12, Action::Mode(TeleopMode::WheelForward));
+    assert_eq!(op.velocity(), (0.0, 0.0));
+}
+
+#[test]
+fn a_lost_pad_sends_stop_then_silence_and_its_return_resumes_the_heartbeat() {
+    let mut op = Operator::new();
+    let mut ctl = FakeController::new();
+    op.observe(&ctl.announce());
+    ctl.decode(&op.poll(0).unwrap());
+    op.press(1, Action::Mode(TeleopMode::Drive));
+    op.press(
+        1,
+        Action::Sticks {
+            forward: 1.0,
+            turn: 0.0,
+        },
+    );
+    ctl.decode(&op.poll(1).unwrap());
+    op.press(5, Action::InputLost);
+    let sent = ctl.decode(&op.poll(5).unwrap());
+    assert!(
+        matches!(
+            sent.as_slice(),
+            [AnyMessage::TeleopCommand(TeleopCommand {
+                mode: TeleopMode::Stop,
+                ..
+            })]
+        ),
+        "{sent:?}"
+    );
+    assert!(op.silent());
+    let quiet: Vec<Frame> = (6..600).flat_map(|t| op.poll(t).unwrap()).collect();
+    assert!(quiet.is_empty(), "{} frames while silent", quiet.len());
+    op.press(700, Action::InputFound);
+    let back = ctl.decode(&op.poll(700).unwrap());
+    assert!(
+        back.iter()
+            .any(|m| matches!(m, AnyMessage::TeleopHeartbeat(_))),
+        "{back:?}"
+    );
+    assert_eq!(op.velocity(), (0.0, 0.0), "the sticks start centred");
+    // Silent or not, an E-stop goes out at once.
+    op.press(701, Action::InputLost);
+    op.poll(701).unwrap();
+    assert!(op.silent());
+    op.press(702, Action::EStop);
+    let latch = op.poll(702).unwrap();
+    assert_eq!(latch.first().map(Frame::id), Some(MessageId::EStop.raw()));
+}
