@@ -7,6 +7,8 @@
 //! renderers on one thread and their order fixed.
 #![cfg(feature = "renderer")]
 
+mod common;
+
 use std::collections::HashSet;
 use std::num::NonZeroU32;
 use std::path::{Path, PathBuf};
@@ -157,4 +159,45 @@ fn frames_of_the_standing_robot_show_the_scene_at_the_configured_size() {
 
     let _ = std::fs::remove_dir_all(&dir);
     let _ = std::fs::remove_dir_all(&full_dir);
+    drop(full);
+    frames_reach_the_mcap();
+}
+
+/// A rendered run's frames are in its MCAP as `/camera` (`foxglove.CompressedImage`), one per
+/// frame, read back by the Python `mcap` reader.
+fn frames_reach_the_mcap() {
+    let out = scratch("mcap");
+    let mut config = common::config(Plant::default(), Vec::new(), Vec::new(), 1.0);
+    config.out_dir = Some(out.clone());
+    config.plots = false;
+    config.frames = Some(sim_host::session::FrameSettings {
+        dir: out.join("frames"),
+        every_cycles: NonZeroU32::new(50).unwrap(),
+    });
+    let report = sim_host::session::run(&config).unwrap();
+    assert_eq!(report.frames.len(), 6, "frames at 0, 0.2, … 1.0 s");
+    let python = std::env::var_os("PROTOCOL_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../.venv/bin/python"));
+    let output = std::process::Command::new(python)
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/read_mcap.py"))
+        .arg(out.join("run.mcap"))
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let text = String::from_utf8_lossy(&output.stdout);
+    let camera = text
+        .split("{\"topic\": ")
+        .find(|c| c.starts_with("\"/camera\""))
+        .unwrap_or_else(|| panic!("no /camera channel: {text}"));
+    assert!(
+        camera.contains("\"schema\": \"foxglove.CompressedImage\""),
+        "{camera}"
+    );
+    assert!(camera.contains("\"count\": 6}"), "{camera}");
+    let _ = std::fs::remove_dir_all(&out);
 }

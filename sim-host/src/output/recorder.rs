@@ -90,6 +90,11 @@ impl Recorder {
         self.foxglove.as_ref()
     }
 
+    /// The Foxglove log, to add a channel to.
+    pub fn foxglove_mut(&mut self) -> Option<&mut FoxgloveLog> {
+        self.foxglove.as_mut()
+    }
+
     /// Logs one frame seen on the bus at `time_s`.
     pub fn frame(&mut self, time_s: f64, frame: &Frame) -> Result<(), OutputError> {
         self.frames += 1;

@@ -20,7 +20,12 @@ use mujoco_rs::error::MjDataError;
 use mujoco_rs::prelude::{MjData, MjModel, MjtObjBase, MjvCamera};
 use mujoco_rs::renderer::{png, MjRenderer, RendererError};
 
+use std::sync::Arc;
+
+use foxglove::Channel;
+
 use crate::output::animation::Animation;
+use crate::output::foxglove::CompressedImage;
 use crate::robot::physics::Physics;
 use crate::session::simulator::Simulator;
 
@@ -152,6 +157,7 @@ pub struct FrameRenderer {
     size_px: (u32, u32),
     frames: Vec<PathBuf>,
     animation: Option<Animation>,
+    camera: Option<Arc<Channel<CompressedImage>>>,
 }
 
 impl std::fmt::Debug for FrameRenderer {
@@ -213,6 +219,7 @@ impl FrameRenderer {
             None => None,
         };
         Ok(Self {
+            camera: None,
             animation,
             renderer,
             mirror: MjData::new(Box::new(model.clone())),
@@ -221,6 +228,11 @@ impl FrameRenderer {
             size_px: (width, height),
             frames: Vec::new(),
         })
+    }
+
+    /// Also logs every frame (its PNG) on `camera`, stamped with simulation time.
+    pub fn publish_to(&mut self, camera: Arc<Channel<CompressedImage>>) {
+        self.camera = Some(camera);
     }
 
     /// Renders a frame if `sim`'s completed cycle count is a multiple of the interval (so
@@ -263,6 +275,24 @@ impl FrameRenderer {
         if let Some(animation) = &mut self.animation {
             let rgb = self.renderer.rgb_flat().unwrap_or(&[]);
             animation.push(rgb)?;
+        }
+        if let Some(camera) = &self.camera {
+            let png = std::fs::read(&path).map_err(|source| RenderError::Animation {
+                source: crate::output::output_error::OutputError::Io {
+                    path: path.clone(),
+                    source,
+                },
+            })?;
+            let time_s = physics.time_s();
+            camera.log_with_time(
+                &CompressedImage {
+                    timestamp: Some(crate::output::foxglove::timestamp(time_s)),
+                    frame_id: CHASE_CAMERA.into(),
+                    data: png.into(),
+                    format: "png".into(),
+                },
+                crate::output::foxglove::nanos(time_s),
+            );
         }
         Ok(path)
     }

@@ -70,7 +70,12 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
     let mut recorder = open_recorder(config, &mut files)?;
     open_foxglove(config, &sim, &mut recorder, &mut files)?;
     let counters: FirmwareCounters = Rc::new(Cell::new(Default::default()));
-    let watch = Watch::open(config, &sim)?;
+    let camera = config
+        .frames
+        .as_ref()
+        .and(recorder.foxglove_mut())
+        .map(|log| log.camera());
+    let watch = Watch::open(config, &sim, camera)?;
     let mut observer = Observer {
         config,
         segments: Segments::new(&config.segments, config.scene.features()),

@@ -28,7 +28,11 @@ pub(crate) struct Watch {
 
 impl Watch {
     /// Opens what `config` asks for and renders the starting frame.
-    pub(crate) fn open(config: &SessionConfig, sim: &Simulator) -> Result<Self, SessionError> {
+    pub(crate) fn open(
+        config: &SessionConfig,
+        sim: &Simulator,
+        camera: Option<std::sync::Arc<foxglove::Channel<crate::output::foxglove::CompressedImage>>>,
+    ) -> Result<Self, SessionError> {
         #[allow(unused_mut)]
         let mut watch = Self::default();
         if let Some(frames) = &config.frames {
@@ -39,12 +43,15 @@ impl Watch {
                 options.animation = Some((frames.animation_path(), animation_delay_cs(config)));
                 let mut renderer =
                     crate::output::render::FrameRenderer::new(sim.physics().model(), options)?;
+                if let Some(camera) = camera {
+                    renderer.publish_to(camera);
+                }
                 renderer.render(sim.physics())?;
                 watch.frames = Some(renderer);
             }
             #[cfg(not(feature = "renderer"))]
             {
-                let _ = frames;
+                let _ = (frames, camera);
                 return Err(SessionError::NotBuilt {
                     what: "rendering frames",
                     feature: "renderer",

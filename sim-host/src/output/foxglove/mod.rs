@@ -11,6 +11,7 @@
 //! | `/controller/log` | `foxglove.Log` | a line per change of mode or fault flags |
 //! | `/can` | JSON `CanFrame` | every frame on the bus: id, message name, data |
 //! | `/robot_description` | JSON `std_msgs/String` | the URDF (also attached to the MCAP, and `robot.urdf` beside it) |
+//! | `/camera` | `foxglove.CompressedImage` | the rendered frames, PNG (only with frames: feature `renderer`) |
 //!
 //! Log times are simulation time. The MCAP is lz4-chunked and flushed with the other logs (at
 //! least once a second), so a killed run leaves it readable up to its last flush (MCAP readers
@@ -25,6 +26,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use foxglove::messages::log::Level as LogLevel;
+pub use foxglove::messages::CompressedImage;
 use foxglove::messages::{FrameTransform, FrameTransforms, Log, Quaternion, Timestamp, Vector3};
 use foxglove::{
     Channel, Context, McapCompression, McapWriteOptions, McapWriterHandle, PartialMetadata,
@@ -62,6 +64,7 @@ pub struct FoxgloveLog {
     last_status: Option<(ControllerMode, FaultFlags)>,
     /// When the description was last logged, s (repeated so that a late viewer gets it).
     described_s: Option<f64>,
+    camera: Option<Arc<Channel<CompressedImage>>>,
 }
 
 impl std::fmt::Debug for FoxgloveLog {
@@ -131,12 +134,22 @@ impl FoxgloveLog {
             channels,
             last_status: None,
             described_s: None,
+            camera: None,
         }))
     }
 
     /// The live server's port, if one runs.
     pub fn live_port(&self) -> Option<u16> {
         self.server.as_ref().map(WebSocketServerHandle::port)
+    }
+
+    /// A channel for the rendered camera's frames (`/camera`, `foxglove.CompressedImage`, PNG),
+    /// made on first use: a run without frames has none.
+    pub fn camera(&mut self) -> Arc<Channel<CompressedImage>> {
+        Arc::clone(
+            self.camera
+                .get_or_insert_with(|| Arc::new(self.context.channel_builder("/camera").build())),
+        )
     }
 
     /// The URDF of the robot.
@@ -403,7 +416,8 @@ fn log_json(channel: &RawChannel, message: &serde_json::Value, at: PartialMetada
     channel.log_with_meta(message.to_string().as_bytes(), at);
 }
 
-fn nanos(time_s: f64) -> u64 {
+/// Simulation time `time_s` as a log time, ns.
+pub fn nanos(time_s: f64) -> u64 {
     (time_s.max(0.0) * 1e9).round() as u64
 }
 
@@ -413,7 +427,8 @@ fn meta(time_s: f64) -> PartialMetadata {
     }
 }
 
-fn timestamp(time_s: f64) -> Timestamp {
+/// The timestamp of simulation time `time_s`.
+pub fn timestamp(time_s: f64) -> Timestamp {
     let ns = nanos(time_s);
     Timestamp::new((ns / 1_000_000_000) as u32, (ns % 1_000_000_000) as u32)
 }
