@@ -250,10 +250,44 @@ fn a_silent_operator_stops_the_robot_within_half_a_second_of_teleop_dying() {
     assert!(!output.status.faults.contains(FaultFlags::AWAITING_STOP));
 }
 
+/// `walk` trots the way the operator's speed points, turning round only past a dead band, and
+/// inside it never strides the wrong way; its yaw rate is held to the trot's limit.
+#[test]
+fn walk_follows_the_speeds_sign_past_a_dead_band_and_never_strides_the_wrong_way() {
+    use firmware::control::fsm::Direction;
+    let mut bench = Bench::ready();
+    bench.send(common::velocity_command(TeleopMode::Walk, 0.1, 0.0));
+    bench.run(2_000);
+    assert_eq!(bench.state(), State::Legs(LegMotion::Walk));
+    let motion = |bench: &Bench| bench.controller.trot_motion().unwrap();
+    let (direction, command) = motion(&bench);
+    assert_eq!(direction, Direction::Forward);
+    assert!(
+        (command.stride_share - 0.1 / 0.145).abs() < 0.01,
+        "{command:?}"
+    );
+    // A stick resting just behind centre: no stride, and still forward.
+    bench.send(common::velocity_command(TeleopMode::Walk, -0.005, 0.0));
+    bench.tick();
+    let (direction, command) = motion(&bench);
+    assert_eq!((direction, command.stride_share), (Direction::Forward, 0.0));
+    // Past the dead band it turns round, and the yaw rate is clamped to 0.4 rad/s.
+    bench.send(common::velocity_command(TeleopMode::Walk, -0.1, 2.0));
+    bench.tick();
+    let (direction, command) = motion(&bench);
+    assert_eq!(direction, Direction::Backward);
+    assert!(
+        (command.stride_share - 0.1 / 0.145).abs() < 0.01,
+        "{command:?}"
+    );
+    assert_eq!(command.yaw_rate_rad_s, 0.4);
+    assert_eq!(bench.state(), State::Legs(LegMotion::Walk));
+}
+
 fn any_message() -> impl Strategy<Value = AnyMessage> {
     let angle = (-3.3f32..3.3).prop_map(Angle::saturating_from_si);
     let leg = prop::sample::select(Leg::ALL.to_vec());
-    let mode = (0u8..8).prop_map(|raw| TeleopMode::from_raw(raw).unwrap());
+    let mode = (0u8..10).prop_map(|raw| TeleopMode::from_raw(raw).unwrap());
     prop_oneof![
         (leg, prop::array::uniform4(angle.clone())).prop_map(|(leg, position)| {
             AnyMessage::LegFeedback(
@@ -279,15 +313,15 @@ fn any_message() -> impl Strategy<Value = AnyMessage> {
                 effort: [Torque::saturating_from_si(0.0); 2],
             }
         )),
-        (mode, -0.2f32..0.2, 0u8..=100).prop_map(|(mode, h, s)| AnyMessage::TeleopCommand(
-            TeleopCommand {
+        (mode, -0.2f32..0.2, 0u8..=100, -2.5f32..2.5, -3.5f32..3.5).prop_map(
+            |(mode, h, s, v, w)| AnyMessage::TeleopCommand(TeleopCommand {
                 mode,
                 body_height: BodyHeight::saturating_from_si(h),
                 speed_scale: SpeedScale::from_raw(s).unwrap(),
-                speed: Default::default(),
-                yaw_rate: Default::default(),
-            }
-        )),
+                speed: protocol::GroundSpeed::saturating_from_si(v),
+                yaw_rate: protocol::YawRate::saturating_from_si(w),
+            })
+        ),
         Just(AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
             uptime: protocol::Millis::from_raw(0).unwrap()
         })),

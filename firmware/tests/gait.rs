@@ -287,20 +287,45 @@ fn a_turning_trot_strides_each_foot_along_its_hips_path() {
     let [sfl, sfr, ..] = strides;
     // Unshrunk: 1 − 0.412 and 1 + 0.412; the ratio holds after shrinking.
     assert!((sfl.along / sfr.along - 0.588 / 1.412).abs() < 1e-3);
-    // Every turning pose solves.
-    let mut turning = trot;
-    for _ in 0..250 {
-        for result in turning.targets(
-            Direction::Forward,
-            CONFIG.posture.depth_nominal_m,
-            &fast,
-            &Attitude::default(),
-            &CONFIG.geometry,
-            &CONFIG.limits,
-            &CONFIG.posture,
-        ) {
-            assert!(result.is_ok(), "{result:?}");
+    // Every turning pose solves: both ways, across the trot's depths, rolled as far as the
+    // body levelling reaches, at full stride and turning on the spot.
+    let on_the_spot = TrotCommand {
+        stride_share: 0.0,
+        yaw_rate_rad_s: -0.4,
+    };
+    let posture = &CONFIG.posture;
+    for command in [fast, on_the_spot] {
+        for direction in [Direction::Forward, Direction::Backward] {
+            for depth_m in [
+                posture.trot_depth_min_m,
+                posture.depth_nominal_m,
+                posture.depth_max_m,
+            ] {
+                for roll_rad in [-0.3, 0.0, 0.3] {
+                    let attitude = Attitude {
+                        roll_rad,
+                        ..Attitude::default()
+                    };
+                    let mut turning = trot;
+                    for _ in 0..250 {
+                        for result in turning.targets(
+                            direction,
+                            depth_m,
+                            &command,
+                            &attitude,
+                            &CONFIG.geometry,
+                            &CONFIG.limits,
+                            posture,
+                        ) {
+                            assert!(
+                                result.is_ok(),
+                                "{command:?} {direction:?} {depth_m} {roll_rad}: {result:?}"
+                            );
+                        }
+                        turning.advance();
+                    }
+                }
+            }
         }
-        turning.advance();
     }
 }

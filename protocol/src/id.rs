@@ -33,7 +33,8 @@ pub enum MessageId {
     WheelFeedback,
     /// Torso IMU sample.
     Imu,
-    /// Operator command (the report's keys plus stand, fold, height, speed).
+    /// Operator command (the report's keys plus stand, fold, drive, walk; height, speed scale,
+    /// ground speed, yaw rate).
     TeleopCommand,
     /// Operator liveness.
     TeleopHeartbeat,

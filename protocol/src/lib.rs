@@ -102,6 +102,7 @@ mod frame;
 mod id;
 mod joints;
 mod message;
+pub mod motion_limits;
 mod msg;
 mod node;
 mod receiver;

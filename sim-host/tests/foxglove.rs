@@ -19,6 +19,7 @@ use sim_host::output::foxglove::bodies::{Pose, RobotTree};
 use sim_host::output::foxglove::ROOT_BODY;
 use sim_host::robot::model::DEFAULT_MODEL;
 use sim_host::robot::plant::Plant;
+use sim_host::robot::rotation::rpy_rad;
 use sim_host::session;
 use teleop_core::scripted::PlanStep;
 
@@ -48,14 +49,6 @@ fn out_dir(name: &str) -> PathBuf {
         .join(name);
     let _ = std::fs::remove_dir_all(&dir);
     dir
-}
-
-/// Roll, pitch, yaw of `[w, x, y, z]`, degrees (as the telemetry reports them).
-fn rpy_deg([w, x, y, z]: [f64; 4]) -> [f64; 3] {
-    let roll = (2.0 * (w * x + y * z)).atan2(1.0 - 2.0 * (x * x + y * y));
-    let pitch = (2.0 * (w * y - z * x)).clamp(-1.0, 1.0).asin();
-    let yaw = (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z));
-    [roll, pitch, yaw].map(f64::to_degrees)
 }
 
 #[test]
@@ -144,7 +137,11 @@ fn the_mcap_opens_in_an_independent_reader_with_every_channel_and_mujocos_torso_
         for (logged, sampled) in xyz.iter().zip(row.torso_pos_m) {
             worst_m = worst_m.max((logged - sampled).abs());
         }
-        for (logged, sampled) in rpy_deg(wxyz).iter().zip(row.torso_rpy_deg) {
+        for (logged, sampled) in rpy_rad(wxyz)
+            .map(f64::to_degrees)
+            .iter()
+            .zip(row.torso_rpy_deg)
+        {
             worst_deg = worst_deg.max((logged - sampled).abs());
         }
     }

@@ -11,16 +11,8 @@ use sim_host::campaign::draw::Draws;
 use sim_host::campaign::Drives;
 use sim_host::faults::rig::Rig;
 use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::robot::rotation::rpy_rad;
 use teleop_core::scripted::PlanStep;
-
-/// Roll, pitch and yaw of a unit quaternion `[w, x, y, z]`, rad.
-fn euler(q: [f64; 4]) -> [f64; 3] {
-    let [w, x, y, z] = q;
-    let roll = (2.0 * (w * x + y * z)).atan2(1.0 - 2.0 * (x * x + y * y));
-    let pitch = (2.0 * (w * y - z * x)).clamp(-1.0, 1.0).asin();
-    let yaw = (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z));
-    [roll, pitch, yaw]
-}
 
 /// The least-squares circle through `points` (Kåsa's fit): centre, radius, and the RMS of the
 /// points' distances from it, m.
@@ -103,7 +95,7 @@ fn run(seed: u64, plan: Vec<PlanStep>, from_s: f64, until_s: f64) -> Turn {
     while rig.time_s() < until_s {
         rig.step().unwrap();
         let torso = rig.sim().physics().torso();
-        let [roll, pitch, yaw] = euler(torso.quat_wxyz);
+        let [roll, pitch, yaw] = rpy_rad(torso.quat_wxyz);
         if let Some(last) = last_yaw {
             let mut change = yaw - last;
             change -= (change / std::f64::consts::TAU).round() * std::f64::consts::TAU;

@@ -94,10 +94,9 @@ impl App {
         self.operator.press(now_ms, act);
         match act {
             Action::EStop => self.note("E-STOP latched (pad): press Start twice to release".into()),
-            Action::InputLost => {
-                self.note("gamepad lost: the robot was told to stop; X, then a motion".into())
-            }
-            Action::InputFound => self.note("gamepad back: X, then a motion".into()),
+            Action::InputLost => self
+                .note("gamepad lost: the robot was told to stop and the operator is silent".into()),
+            Action::InputFound => self.note("gamepad back: press a motion to move".into()),
             Action::Mode(mode) => self.note(format!("command {} (pad)", mode_text(mode))),
             _ => {}
         }

@@ -191,6 +191,7 @@ fn button_of(code: KeyCode) -> Option<PadButton> {
         KeyCode::BTN_TL => PadButton::LeftShoulder,
         KeyCode::BTN_TR => PadButton::RightShoulder,
         KeyCode::BTN_START => PadButton::Start,
+        KeyCode::BTN_SELECT => PadButton::Select,
         KeyCode::BTN_DPAD_UP => PadButton::DPadUp,
         KeyCode::BTN_DPAD_DOWN => PadButton::DPadDown,
         _ => return None,

@@ -47,9 +47,10 @@ struct Cli {
     /// firmware-host's). Without it, the public test key of simulation and CI.
     #[arg(long, value_name = "PATH")]
     key_file: Option<PathBuf>,
-    /// Also drive with a gamepad (sticks: speed and yaw rate; A drive, Y walk, X stop, B
-    /// E-stop, Start twice release, shoulders fold / stand, D-pad height): the first one found,
-    /// or the evdev device named (/dev/input/eventN). `teleop pad` uses it without a screen.
+    /// Also drive with a gamepad (sticks: speed and yaw rate; A drive, right shoulder walk, X
+    /// or Y stop, B E-stop, Start twice release, left shoulder stand, Select fold, D-pad
+    /// height): the first one found, or the evdev device named (/dev/input/eventN). `teleop
+    /// pad` uses it without a screen.
     #[arg(long, value_name = "DEVICE", num_args = 0..=1, default_missing_value = "auto")]
     gamepad: Option<String>,
     #[command(subcommand)]
@@ -256,6 +257,12 @@ fn operate(
 /// The gamepad `--gamepad` names (or `teleop pad` wants), opened; `None` without one.
 fn open_pad(cli: &Cli) -> Result<Option<teleop::gamepad::PadReader>, Failure> {
     let wanted = match (&cli.gamepad, &cli.command) {
+        (Some(_), Some(Command::Send { .. } | Command::Script { .. })) => {
+            return Err(Failure::usage(
+                "--gamepad drives the interactive operator or `teleop pad`, not `send` or `script`"
+                    .into(),
+            ))
+        }
         (Some(device), _) => Some(device.as_str()),
         (None, Some(Command::Pad { .. })) => Some("auto"),
         (None, _) => None,

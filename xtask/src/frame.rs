@@ -12,16 +12,16 @@
 use std::path::PathBuf;
 
 use protocol::{
-    AnyMessage, BodyHeight, EStop, Epoch, Frame, Key, NodeId, ReleaseToken, Session, SessionTime,
-    SpeedScale, TeleopCommand, TEST_KEY,
+    AnyMessage, BodyHeight, EStop, Epoch, Frame, GroundSpeed, Key, NodeId, ReleaseToken, Session,
+    SessionTime, SpeedScale, TeleopCommand, YawRate, TEST_KEY,
 };
 
 pub const USAGE: &str = "\
 cargo xtask frame latch [--source tool|teleop] [--classic] [--bus IFACE]
 cargo xtask frame release --epoch N --time-ms T --token N [--key-file FILE] [--bus IFACE]
 cargo xtask frame command MODE --epoch N --time-ms T [--height-m H] [--speed-pct P]
-                          [--key-file FILE] [--bus IFACE]
-  MODE: the report's keys W S A L K X, or stand, fold; IFACE defaults to vcan0;
+                          [--speed-m-s V] [--yaw-rate-rad-s W] [--key-file FILE] [--bus IFACE]
+  MODE: the report's keys W S A L K X, or stand, fold, drive, walk; IFACE defaults to vcan0;
   --time-ms is the Announce's `time` in ms (cantools shows it in seconds); the frame is
   found by the controller for about 98 s after that time;
   without --key-file the public test key of the simulation is used";
@@ -110,6 +110,8 @@ fn parse(args: &[String]) -> Result<Request, String> {
     let mut mode = None;
     let mut height_m = 0.0_f32;
     let mut speed_pct = 100.0_f32;
+    let mut speed_m_s = 0.0_f32;
+    let mut yaw_rate_rad_s = 0.0_f32;
     let mut words = rest.iter();
     while let Some(word) = words.next() {
         let mut value = |flag: &str| {
@@ -128,6 +130,10 @@ fn parse(args: &[String]) -> Result<Request, String> {
             "--bus" => request.bus = value("--bus")?,
             "--height-m" => height_m = number("--height-m", &value("--height-m")?)?,
             "--speed-pct" => speed_pct = number("--speed-pct", &value("--speed-pct")?)?,
+            "--speed-m-s" => speed_m_s = number("--speed-m-s", &value("--speed-m-s")?)?,
+            "--yaw-rate-rad-s" => {
+                yaw_rate_rad_s = number("--yaw-rate-rad-s", &value("--yaw-rate-rad-s")?)?
+            }
             other if kind == "command" && mode.is_none() && !other.starts_with("--") => {
                 mode = Some(teleop_core::scenario::parse_mode(other).ok_or_else(|| {
                     format!("unknown mode `{other}`: use W S A L K X, stand, fold, drive or walk")
@@ -152,8 +158,11 @@ fn parse(args: &[String]) -> Result<Request, String> {
                 .ok_or_else(|| format!("--height-m {height_m} is outside −0.10…0.12 m"))?,
             speed_scale: SpeedScale::from_si(speed_pct)
                 .ok_or_else(|| format!("--speed-pct {speed_pct} is outside 0…100"))?,
-            speed: Default::default(),
-            yaw_rate: Default::default(),
+            speed: GroundSpeed::from_si(speed_m_s)
+                .ok_or_else(|| format!("--speed-m-s {speed_m_s} is outside −2…2 m/s"))?,
+            yaw_rate: YawRate::from_si(yaw_rate_rad_s).ok_or_else(|| {
+                format!("--yaw-rate-rad-s {yaw_rate_rad_s} is outside −3…3 rad/s")
+            })?,
         }),
         other => return Err(format!("unknown frame `{other}`\n{USAGE}")),
     };

@@ -19,13 +19,14 @@ pub struct SteeringConfig {
 }
 
 impl SteeringConfig {
-    /// The robot: wheels 0.46 m apart; 1 rad/s on the wheels (a curve of 0.48 m radius at full
+    /// The robot: wheels 0.46 m apart; the yaw-rate limits the operator is told of
+    /// ([`protocol::motion_limits`]): 1 rad/s on the wheels (a curve of 0.48 m radius at full
     /// speed, within the turn loop's quarter of the wheel torque), 0.4 rad/s on the legs (the
     /// front and back feet stride 0.6 of the full stride sideways at a turn on the spot).
     pub const ROBOT: Self = Self {
         wheel_track_m: 0.46,
-        wheel_yaw_limit_rad_s: 1.0,
-        trot_yaw_limit_rad_s: 0.4,
+        wheel_yaw_limit_rad_s: protocol::motion_limits::DRIVE_LIMITS.yaw_rate_rad_s,
+        trot_yaw_limit_rad_s: protocol::motion_limits::WALK_LIMITS.yaw_rate_rad_s,
     };
 
     /// The yaw rate the wheels take for `requested_rad_s` (0 for a non-finite one).
@@ -71,5 +72,19 @@ mod tests {
         assert_eq!(steering.wheel_yaw_rad_s(5.0), 1.0);
         assert_eq!(steering.trot_yaw_rad_s(-5.0), -0.4);
         assert_eq!(steering.wheel_yaw_rad_s(f32::NAN), 0.0);
+    }
+
+    /// The speeds the operator is told of are the robot's: W's full speed on the wheels, the
+    /// trot's full stride on the legs.
+    #[test]
+    fn the_operators_speed_limits_are_the_robots() {
+        let config = crate::config::Config::ROBOT;
+        let wheels_m_s = config.wheel_speed_rad_s * config.balance.wheel_radius_m;
+        let drive = protocol::motion_limits::DRIVE_LIMITS.speed_m_s;
+        assert!((wheels_m_s - drive).abs() < 1e-5, "{wheels_m_s} vs {drive}");
+        let trot = crate::legs::gait::Trot::new(config.trot, config.rate);
+        let full_m_s = trot.and_then(|t| t.full_speed_m_s()).unwrap_or(0.0);
+        let walk = protocol::motion_limits::WALK_LIMITS.speed_m_s;
+        assert!((full_m_s - walk).abs() < 0.001, "{full_m_s} vs {walk}");
     }
 }

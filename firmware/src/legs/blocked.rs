@@ -55,8 +55,10 @@ pub struct BlockedConfig {
     /// The count of one leg (up one per blocked swing, down one per free swing) that stops
     /// the trot (0: never).
     pub count: u8,
-    /// The lowest speed scale (0…1) the watch runs at; a lag is divided by the scale, which
-    /// the stride is proportional to, before it is compared with the thresholds.
+    /// The lowest stride share (0…1: the leg's fore–aft stride as a share of the full one —
+    /// the speed scale walking straight, less for the inner legs of a turn) the watch runs
+    /// at; a lag is divided by the share, which it is proportional to, before it is compared
+    /// with the thresholds.
     /// Measured at 50 % and 30 %: none of 100 flat-ground trots stopped, 16 and 14 of 16
     /// trots into a 9–11 cm riser did (the other two had not reached it in 28 s); at 20 %
     /// none reached it.

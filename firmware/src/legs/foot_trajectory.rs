@@ -56,20 +56,13 @@ impl FootTrajectory {
         duty: 0.55,
     };
 
-    /// The foot position `(x_m, z_m)` at `phase` for a stance line `depth_m` below the hip,
-    /// with the stride scaled by `scale` (0…1, clamped). Stance takes the first
-    /// [`FootTrajectory::duty`] of the cycle and pushes the foot backward, so the body moves
-    /// forward; run the phase backward ([`Phase::reversed`]) to walk backward.
-    pub fn foot(&self, phase: Phase, depth_m: f32, scale: f32) -> (f32, f32) {
-        let foot = self.foot_on_stride(phase, depth_m, crate::math::clamp(scale, 0.0, 1.0), 0.0);
-        (foot.x_m, foot.z_m)
-    }
-
     /// The foot position at `phase` for a stride of `along` full strides fore–aft and `across`
     /// full strides to the left (each −1…1; a turning trot's legs stride differently and
     /// sideways): stance carries the foot from `+(along, across)·L/2` to `−(along, across)·L/2`
-    /// around the stride's centre, and swing back through the air. A foot with no stride
-    /// stays down.
+    /// around the stride's centre, and swing back through the air. Stance takes the first
+    /// [`FootTrajectory::duty`] of the cycle and pushes the foot backward (for a positive
+    /// `along`), so the body moves forward; run the phase backward ([`Phase::reversed`]) to
+    /// walk backward. A foot with no stride stays down.
     pub fn foot_on_stride(&self, phase: Phase, depth_m: f32, along: f32, across: f32) -> FootPoint {
         let half = 0.5 * self.step_length_m;
         let fraction = phase.fraction();

@@ -119,6 +119,17 @@ pub fn plant_feedback_rolling(joints_rad: &Joints<f32>, wheel_rate_rad_s: f32) -
     messages
 }
 
+/// The operator asking for `mode` at `speed_m_s` and `yaw_rate_rad_s` (drive, walk, steering).
+pub fn velocity_command(mode: TeleopMode, speed_m_s: f32, yaw_rate_rad_s: f32) -> AnyMessage {
+    AnyMessage::TeleopCommand(TeleopCommand {
+        mode,
+        body_height: BodyHeight::saturating_from_si(0.0),
+        speed_scale: SpeedScale::from_raw(100).unwrap(),
+        speed: protocol::GroundSpeed::saturating_from_si(speed_m_s),
+        yaw_rate: protocol::YawRate::saturating_from_si(yaw_rate_rad_s),
+    })
+}
+
 /// The operator asking for `mode` at nominal height and full speed.
 pub fn command(mode: TeleopMode) -> AnyMessage {
     AnyMessage::TeleopCommand(TeleopCommand {

@@ -10,7 +10,7 @@ use crate::units::{BodyHeight, GroundSpeed, SpeedScale, TeleopMode, YawRate};
 ///
 /// | byte | field         | type | meaning                                            |
 /// |------|---------------|------|----------------------------------------------------|
-/// | 6    | `mode`        | u8   | [`TeleopMode`]: X W S A L K, stand, fold            |
+/// | 6    | `mode`        | u8   | [`TeleopMode`]: X W S A L K, stand, fold, drive, walk |
 /// | 7–8  | `body_height` | i16  | offset from nominal height, 1e-4 m, −0.10…+0.12 m   |
 /// | 9    | `speed_scale` | u8   | 1 %, 0…100                                           |
 /// | 10–11| `speed`       | i16  | ground speed, 1e-3 m/s, −2…+2 m/s, + forward         |

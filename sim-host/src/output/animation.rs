@@ -67,12 +67,11 @@ impl Animation {
     pub fn push(&mut self, rgb: &[u8]) -> Result<(), OutputError> {
         let (width, height) = self.source_px;
         if rgb.len() != (width * height * 3) as usize {
-            return Err(OutputError::Plot {
+            return Err(OutputError::FrameSize {
                 path: self.path.clone(),
-                message: format!(
-                    "a frame of {} bytes is not {width} × {height} RGB",
-                    rgb.len()
-                ),
+                bytes: rgb.len(),
+                width,
+                height,
             });
         }
         halve(rgb, self.source_px, &mut self.scaled);
@@ -134,16 +133,18 @@ fn halve(rgb: &[u8], (width, height): (u32, u32), out: &mut Vec<u8>) {
 }
 
 fn too_large(path: &Path, (width, height): (u32, u32)) -> OutputError {
-    OutputError::Plot {
+    OutputError::FrameSize {
         path: path.to_owned(),
-        message: format!("frames of {width} × {height} px are too large for a GIF"),
+        bytes: (width as usize) * (height as usize) * 3,
+        width,
+        height,
     }
 }
 
-fn encode_error(path: &Path, e: gif::EncodingError) -> OutputError {
-    OutputError::Plot {
+fn encode_error(path: &Path, source: gif::EncodingError) -> OutputError {
+    OutputError::Gif {
         path: path.to_owned(),
-        message: format!("GIF encoder: {e}"),
+        source,
     }
 }
 

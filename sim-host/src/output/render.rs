@@ -137,6 +137,14 @@ pub enum RenderError {
         #[from]
         source: crate::output::output_error::OutputError,
     },
+    /// A frame just written could not be read back for the camera channel.
+    #[error("cannot read back the frame {}: {source}", path.display())]
+    ReadBack {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
     /// The physics is not the model the renderer was made for.
     #[error("the renderer was made for another model: {source}")]
     OtherModel {

@@ -1,4 +1,4 @@
-//! The robot: its MuJoCo [`model`] and [`physics`] (ground truth), and the hardware a real
+//! The robot: its MuJoCo [`model`] and [`physics`] (ground truth, with [`rotation`] math), and the hardware a real
 //! robot puts on the bus, emulated — four [`leg_drive`]s and the [`wheel_drive`] (sharing
 //! [`drive_core`], each at its [`rating`], measuring as [`sensing`] says), the [`imu`] (its chip:
 //! [`imu_chip`]), all together in [`hardware`]; the [`plant`] picks the parts.
@@ -13,6 +13,7 @@ pub mod model;
 pub mod physics;
 pub mod plant;
 pub mod rating;
+pub mod rotation;
 pub mod sensing;
 pub mod variation;
 pub mod wheel_drive;

@@ -5,6 +5,8 @@
 use std::path::Path;
 
 use mujoco_rs::prelude::{MjData, MjModel};
+
+use crate::robot::rotation;
 use mujoco_rs::wrappers::mj_model::MjtGeomBase as MjtGeom;
 use mujoco_rs::wrappers::mj_model::MjtObjBase as MjtObj;
 use protocol::{Joints, Leg};
@@ -28,11 +30,7 @@ pub struct TorsoState {
 impl TorsoState {
     /// Roll, pitch, yaw (Z-Y-X Euler angles), rad. Pitch + = nose down (rotation about +y).
     pub fn rpy_rad(&self) -> [f64; 3] {
-        let [w, x, y, z] = self.quat_wxyz;
-        let roll = (2.0 * (w * x + y * z)).atan2(1.0 - 2.0 * (x * x + y * y));
-        let pitch = (2.0 * (w * y - z * x)).clamp(-1.0, 1.0).asin();
-        let yaw = (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z));
-        [roll, pitch, yaw]
+        rotation::rpy_rad(self.quat_wxyz)
     }
 
     /// Angle between the torso's up axis and the world's, rad: the tilt, whatever its direction.
@@ -45,27 +43,15 @@ impl TorsoState {
 
     /// `v_torso`, a vector in the torso frame, in the world frame.
     pub fn to_world(&self, v_torso: [f64; 3]) -> [f64; 3] {
-        let [w, x, y, z] = self.quat_wxyz;
-        let u = [x, y, z];
-        let t = cross(u, v_torso).map(|c| 2.0 * c);
-        let ut = cross(u, t);
-        [0, 1, 2].map(|i| v_torso[i] + w * t[i] + ut[i])
+        rotation::rotate(self.quat_wxyz, v_torso)
     }
 
     /// World velocity of the point `offset_m` from the torso's origin (torso frame), m/s: the
     /// torso's velocity plus its rotation about its origin.
     pub fn point_velocity_m_s(&self, offset_m: [f64; 3]) -> [f64; 3] {
-        let spin = cross(self.to_world(self.ang_vel_rad_s), self.to_world(offset_m));
+        let spin = rotation::cross(self.to_world(self.ang_vel_rad_s), self.to_world(offset_m));
         [0, 1, 2].map(|i| self.vel_m_s[i] + spin[i])
     }
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// What touches the ground (any geom outside the robot's subtree).

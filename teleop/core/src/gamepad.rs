@@ -7,18 +7,24 @@
 //! | left stick, up / down | ground speed, forward / backward (`drive` and `walk`) |
 //! | right stick, left / right | yaw rate, turn left / right (`drive` and `walk`) |
 //! | A (south) | `drive`: balance on the wheels at the sticks' speed and yaw rate |
-//! | Y (north) | `walk`: trot at the sticks' speed and yaw rate |
-//! | X (west) | stop (the report's `X`) |
+//! | right shoulder | `walk`: trot at the sticks' speed and yaw rate |
+//! | X or Y (west, north) | stop (the report's `X`) |
 //! | B (east, the red one) | **E-stop**: latched at once, as the keyboard's space |
 //! | Start twice within 2 s | release a latched E-stop, as the keyboard's `R R` |
-//! | left / right shoulder | fold onto the wheels / stand on the legs |
+//! | left shoulder | stand on the legs |
+//! | Select (Back) | fold onto the wheels |
 //! | D-pad up / down | body height +1 cm / −1 cm |
+//!
+//! X and Y both stop: the kernel's gamepad API names them by position (west, north), but the
+//! common Xbox drivers (xpad, xone, xpadneo) report them swapped, so neither may start a
+//! motion.
 //!
 //! The sticks are read as fractions of their travel; the operator turns them into a speed and
 //! a yaw rate within the robot's limits for the mode ([`crate::operator`]). A pad that
 //! disconnects is an operator lost: the operator sends STOP at once and falls silent, so that
 //! the controller's heartbeat watchdog holds the robot too, and after the pad is back nothing
-//! moves until STOP and a new motion (the controller's restart interlock).
+//! moves until a new motion is pressed (the operator comes back at STOP, which the controller's
+//! restart interlock wants first).
 
 use protocol::TeleopMode;
 
@@ -34,9 +40,9 @@ pub enum PadButton {
     South,
     /// The right face button (B, red).
     East,
-    /// The left face button (X).
+    /// The left face button (X; Y on Xbox drivers that swap them).
     West,
-    /// The top face button (Y).
+    /// The top face button (Y; X on Xbox drivers that swap them).
     North,
     /// The left shoulder button.
     LeftShoulder,
@@ -44,6 +50,8 @@ pub enum PadButton {
     RightShoulder,
     /// Start.
     Start,
+    /// Select (Back).
+    Select,
     /// D-pad up.
     DPadUp,
     /// D-pad down.
@@ -118,12 +126,12 @@ impl Gamepad {
 pub const fn button_action(button: PadButton) -> Option<Action> {
     Some(match button {
         PadButton::South => Action::Mode(TeleopMode::Drive),
-        PadButton::North => Action::Mode(TeleopMode::Walk),
-        PadButton::West => Action::Mode(TeleopMode::Stop),
+        PadButton::RightShoulder => Action::Mode(TeleopMode::Walk),
+        PadButton::West | PadButton::North => Action::Mode(TeleopMode::Stop),
         PadButton::East => Action::EStop,
         PadButton::Start => Action::Release,
-        PadButton::LeftShoulder => Action::Mode(TeleopMode::Fold),
-        PadButton::RightShoulder => Action::Mode(TeleopMode::Stand),
+        PadButton::LeftShoulder => Action::Mode(TeleopMode::Stand),
+        PadButton::Select => Action::Mode(TeleopMode::Fold),
         PadButton::DPadUp => Action::Height(0.01),
         PadButton::DPadDown => Action::Height(-0.01),
     })
@@ -165,6 +173,13 @@ mod tests {
             Some(Action::Sticks { forward: 0.0, turn })
         );
         assert_eq!(pad.action(PadInput::Axis(PadAxis::LeftX, 1.0)), None);
+    }
+
+    #[test]
+    fn neither_x_nor_y_starts_a_motion_whichever_way_a_driver_names_them() {
+        for button in [PadButton::West, PadButton::North] {
+            assert_eq!(button_action(button), Some(Action::Mode(TeleopMode::Stop)));
+        }
     }
 
     #[test]

@@ -10,6 +10,8 @@ use protocol::{
     Millis, NodeId, SpeedScale, TeleopCommand, TeleopHeartbeat, TeleopMode, YawRate, TEST_KEY,
 };
 
+use protocol::motion_limits::{DRIVE_LIMITS, WALK_LIMITS};
+
 use crate::keys::Action;
 use crate::link::OperatorLink;
 use crate::release::{Release, ReleaseOutcome};
@@ -28,14 +30,6 @@ pub const LATCH_REPEAT_MS: u64 = 4;
 pub const RELEASE_WINDOW_MS: u64 = 2_000;
 /// Body-height range of the wire, m.
 pub const BODY_HEIGHT_RANGE_M: (f32, f32) = (-0.10, 0.12);
-/// A gamepad's full stick in `drive`: the controller's limits on the wheels (W's full speed,
-/// m/s, and its yaw-rate limit, rad/s).
-pub const DRIVE_LIMITS: (f32, f32) = (0.48, 1.0);
-/// A gamepad's full stick in `walk`: the trot's full stride, m/s, and its yaw-rate limit, rad/s.
-pub const WALK_LIMITS: (f32, f32) = (0.145, 0.4);
-/// A moving stick sends its command at most this often, ms (a mode change goes at once): the
-/// controller takes two operator commands per control tick.
-pub const STICK_PERIOD_MS: u64 = 10;
 
 /// The keys' steering range, rad/s: the controller's own limits are tighter on the legs
 /// (0.4 rad/s) and take what it can.
@@ -60,10 +54,6 @@ pub struct Operator {
     yaw_rate_rad_s: f32,
     /// A gamepad's sticks, forward and left turn, fractions of the mode's limits.
     sticks: (f32, f32),
-    /// Whether the sticks moved since the last command.
-    sticks_changed: bool,
-    /// When the last command went out.
-    last_command_ms: Option<u64>,
     /// Whether the input device is gone: nothing but an E-stop goes out (after the STOP that
     /// says so), as if the operator had left.
     silent: bool,
@@ -103,8 +93,6 @@ impl Operator {
             speed_scale_pct: 100.0,
             yaw_rate_rad_s: 0.0,
             sticks: (0.0, 0.0),
-            sticks_changed: false,
-            last_command_ms: None,
             silent: false,
             silence_after_command: false,
             estop_latched: false,
@@ -181,15 +169,17 @@ impl Operator {
     /// within the mode's limits in `drive` and `walk`, plus the keys' steering.
     pub fn velocity(&self) -> (f32, f32) {
         let (forward, turn) = self.sticks;
+        // A full stick asks for the robot's limits in the mode.
         let limits = match self.mode {
             TeleopMode::Drive => Some(DRIVE_LIMITS),
             TeleopMode::Walk => Some(WALK_LIMITS),
             _ => None,
         };
         match limits {
-            Some((speed_m_s, yaw_rad_s)) => {
-                (forward * speed_m_s, turn * yaw_rad_s + self.yaw_rate_rad_s)
-            }
+            Some(limits) => (
+                forward * limits.speed_m_s,
+                turn * limits.yaw_rate_rad_s + self.yaw_rate_rad_s,
+            ),
             None => (0.0, self.yaw_rate_rad_s),
         }
     }
@@ -237,9 +227,9 @@ impl Operator {
         }
         match action {
             Action::Sticks { forward, turn } => {
-                let before = self.wire_velocity();
+                // Levels: they ride on the next periodic command (a stick moving all the time
+                // adds no frames to the bus schedule's 50 Hz slot).
                 self.sticks = (clamp_unit(forward), clamp_unit(turn));
-                self.sticks_changed |= self.wire_velocity() != before;
             }
             Action::InputLost => {
                 self.mode = TeleopMode::Stop;
@@ -341,11 +331,7 @@ impl Operator {
             return Ok(frames);
         }
         let periodic = now_ms >= self.next_send_ms;
-        let sticks_due = self.sticks_changed
-            && self
-                .last_command_ms
-                .is_none_or(|at| now_ms.saturating_sub(at) >= STICK_PERIOD_MS);
-        if self.command_changed || periodic || sticks_due {
+        if self.command_changed || periodic {
             let (speed, yaw_rate) = self.wire_velocity();
             let command = AnyMessage::TeleopCommand(TeleopCommand {
                 mode: self.mode,
@@ -358,8 +344,6 @@ impl Operator {
             if let Some(frame) = self.link.seal(&command)? {
                 frames.push(frame);
                 self.command_changed = false;
-                self.sticks_changed = false;
-                self.last_command_ms = Some(now_ms);
                 if std::mem::take(&mut self.silence_after_command) {
                     self.silent = true;
                     return Ok(frames);
@@ -387,7 +371,7 @@ impl Operator {
 mod tests;
 
 impl Operator {
-    /// The velocity as the wire carries it (what decides whether a stick's move is news).
+    /// The velocity as the wire carries it.
     fn wire_velocity(&self) -> (GroundSpeed, YawRate) {
         let (speed_m_s, yaw_rad_s) = self.velocity();
         (

@@ -129,6 +129,23 @@ pub fn parse_mode(text: &str) -> Option<TeleopMode> {
     }
 }
 
+/// Whether `mode` follows a ground speed: `drive` and `walk`.
+pub const fn takes_speed(mode: TeleopMode) -> bool {
+    matches!(mode, TeleopMode::Drive | TeleopMode::Walk)
+}
+
+/// Whether a yaw rate steers `mode`: W, S, L, K, `drive` and `walk`.
+pub const fn takes_yaw_rate(mode: TeleopMode) -> bool {
+    takes_speed(mode)
+        || matches!(
+            mode,
+            TeleopMode::WheelForward
+                | TeleopMode::WheelBackward
+                | TeleopMode::TrotForward
+                | TeleopMode::TrotBackward
+        )
+}
+
 /// A plan step as a command line gives it (`--drive`): `SECONDS:MODE[,speed=M_S][,yaw=RAD_S]`,
 /// e.g. `2:W`, `6:W,yaw=0.3`, `4:drive,speed=0.3,yaw=-0.2`; the same checks as a scenario
 /// file's step, with a message naming the part that is wrong.
@@ -167,7 +184,7 @@ pub fn parse_drive_step(text: &str) -> Result<PlanStep, String> {
                 })
         };
         match key.trim() {
-            "speed" if matches!(mode, TeleopMode::Drive | TeleopMode::Walk) => {
+            "speed" if takes_speed(mode) => {
                 step.speed_m_s = number(-2.0..=2.0, "m/s")?;
             }
             "speed" => return Err(format!("`{part}`: only drive and walk take a speed")),
@@ -323,21 +340,12 @@ impl Source<'_> {
 
     /// The step's ground speed and yaw rate, each refused for a mode that ignores it.
     fn velocity(&self, s: &RawStep, mode: TeleopMode) -> Result<(f64, f64), ScenarioError> {
-        let velocity_mode = matches!(mode, TeleopMode::Drive | TeleopMode::Walk);
-        let steered = velocity_mode
-            || matches!(
-                mode,
-                TeleopMode::WheelForward
-                    | TeleopMode::WheelBackward
-                    | TeleopMode::TrotForward
-                    | TeleopMode::TrotBackward
-            );
         let name = mode_name(mode);
-        if let (Some(v), false) = (&s.speed_m_s, velocity_mode) {
+        if let (Some(v), false) = (&s.speed_m_s, takes_speed(mode)) {
             let message = format!("speed_m_s: mode {name} ignores it; use drive or walk");
             return Err(self.value_error(v.span().start, message));
         }
-        if let (Some(v), false) = (&s.yaw_rate_rad_s, steered) {
+        if let (Some(v), false) = (&s.yaw_rate_rad_s, takes_yaw_rate(mode)) {
             let message =
                 format!("yaw_rate_rad_s: mode {name} ignores it; use W, S, L, K, drive or walk");
             return Err(self.value_error(v.span().start, message));

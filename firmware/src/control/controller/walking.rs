@@ -12,8 +12,9 @@ const WALK_REVERSE_M_S: f32 = 0.01;
 impl Controller {
     /// The trot's direction and stride in the present state (`None` when the legs do not
     /// trot). The report's sinusoids have no stride in metres: `Walk` drives them at the
-    /// speed's share of the Cartesian default's full speed.
-    pub(super) fn trot_motion(&self) -> Option<(Direction, TrotCommand)> {
+    /// speed's share of the walking limit the operator is told of
+    /// ([`protocol::motion_limits::WALK_LIMITS`]).
+    pub fn trot_motion(&self) -> Option<(Direction, TrotCommand)> {
         let yaw_rate_rad_s = self
             .config
             .steering
@@ -29,10 +30,18 @@ impl Controller {
                 ));
             }
             State::Legs(LegMotion::Walk) => {
-                let full_m_s = self.trot.full_speed_m_s().unwrap_or(DEFAULT_FULL_M_S);
-                let speed_m_s = self.teleop.speed_m_s;
-                if speed_m_s.is_finite() && full_m_s > 0.0 {
-                    crate::math::clamp(speed_m_s.abs() / full_m_s, 0.0, 1.0)
+                let full_m_s = self
+                    .trot
+                    .full_speed_m_s()
+                    .unwrap_or(protocol::motion_limits::WALK_LIMITS.speed_m_s);
+                // The speed in the trot's direction: inside the reversal's dead band a speed
+                // of the other sign is no speed, not a stride the wrong way.
+                let along_m_s = match self.walk_direction {
+                    Direction::Forward => self.teleop.speed_m_s,
+                    Direction::Backward => -self.teleop.speed_m_s,
+                };
+                if along_m_s.is_finite() && full_m_s > 0.0 {
+                    crate::math::clamp(along_m_s / full_m_s, 0.0, 1.0)
                 } else {
                     0.0
                 }
@@ -68,7 +77,3 @@ impl Controller {
         }
     }
 }
-
-/// The Cartesian default's full speed, m/s (8 cm in 55 % of a 1 s cycle), for a trot that has
-/// no stride in metres.
-const DEFAULT_FULL_M_S: f32 = 0.145;

@@ -5,6 +5,8 @@
 //! off the link frame.
 
 use mujoco_rs::prelude::MjModel;
+
+use crate::robot::rotation::{multiply, rotate};
 use mujoco_rs::wrappers::mj_model::{MjtJoint, MjtObjBase as MjtObj};
 
 /// The frame the world is in.
@@ -216,45 +218,20 @@ fn hinges_of(model: &MjModel, body: usize) -> Vec<Hinge> {
         .collect()
 }
 
-/// The inverse of a unit quaternion.
-pub fn conjugate([w, x, y, z]: [f64; 4]) -> [f64; 4] {
-    [w, -x, -y, -z]
-}
-
-/// The Hamilton product `a ⊗ b` (`[w, x, y, z]`).
-pub fn multiply(a: [f64; 4], b: [f64; 4]) -> [f64; 4] {
-    let [aw, ax, ay, az] = a;
-    let [bw, bx, by, bz] = b;
-    [
-        aw * bw - ax * bx - ay * by - az * bz,
-        aw * bx + ax * bw + ay * bz - az * by,
-        aw * by - ax * bz + ay * bw + az * bx,
-        aw * bz + ax * by - ay * bx + az * bw,
-    ]
-}
-
-/// `v` rotated by the unit quaternion `q`.
-pub fn rotate(q: [f64; 4], v: [f64; 3]) -> [f64; 3] {
-    let [_, x, y, z] = multiply(multiply(q, [0.0, v[0], v[1], v[2]]), conjugate(q));
-    [x, y, z]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
     #[test]
-    fn a_quarter_turn_about_z_takes_x_to_y() {
+    fn a_pose_then_another_composes_translation_and_rotation() {
         let half = std::f64::consts::FRAC_PI_4;
-        let q = [half.cos(), 0.0, 0.0, half.sin()];
-        let v = rotate(q, [1.0, 0.0, 0.0]);
-        assert!(v[0].abs() < 1e-12 && (v[1] - 1.0).abs() < 1e-12);
         let turned = Pose {
             translation_m: [1.0, 0.0, 0.0],
-            rotation_wxyz: q,
+            rotation_wxyz: [half.cos(), 0.0, 0.0, half.sin()],
         };
         let composed = turned.then(&turned);
         assert!((composed.translation_m[0] - 1.0).abs() < 1e-12);
         assert!((composed.translation_m[1] - 1.0).abs() < 1e-12);
+        assert_eq!(Pose::IDENTITY.then(&turned), turned);
     }
 }

@@ -100,10 +100,8 @@ impl FoxgloveLog {
             return Ok(None);
         }
         let model = sim.physics().model();
-        let tree = RobotTree::of(model, ROOT_BODY).ok_or_else(|| OutputError::Foxglove {
-            path: outputs.mcap.clone().unwrap_or_default(),
-            message: format!("the model has no body named {ROOT_BODY}"),
-        })?;
+        let tree =
+            RobotTree::of(model, ROOT_BODY).ok_or(OutputError::NoRootBody { body: ROOT_BODY })?;
         let urdf = urdf::urdf(model, &tree, "hybrid_robot");
         let context = Context::new();
         let mcap = match &outputs.mcap {
@@ -117,10 +115,7 @@ impl FoxgloveLog {
                     .name("hybrid-robot sim-host")
                     .bind("127.0.0.1", port)
                     .start_blocking()
-                    .map_err(|e| OutputError::Foxglove {
-                        path: PathBuf::new(),
-                        message: format!("cannot serve on 127.0.0.1:{port}: {e}"),
-                    })?,
+                    .map_err(|source| OutputError::LiveServer { port, source })?,
             ),
             None => None,
         };
@@ -273,9 +268,9 @@ impl FoxgloveLog {
     /// Puts what was logged so far into the file.
     pub fn flush(&mut self) -> Result<(), OutputError> {
         if let Some((path, mcap)) = &self.mcap {
-            mcap.flush().map_err(|e| OutputError::Foxglove {
+            mcap.flush().map_err(|source| OutputError::Mcap {
                 path: path.clone(),
-                message: e.to_string(),
+                source,
             })?;
         }
         Ok(())
@@ -287,10 +282,8 @@ impl FoxgloveLog {
             server.stop().wait_blocking();
         }
         if let Some((path, mcap)) = self.mcap.take() {
-            mcap.close().map_err(|e| OutputError::Foxglove {
-                path,
-                message: e.to_string(),
-            })?;
+            mcap.close()
+                .map_err(|source| OutputError::Mcap { path, source })?;
         }
         drop(self.context);
         Ok(())
@@ -314,9 +307,9 @@ impl Channels {
                     schema_json.to_string().into_bytes(),
                 ))
                 .build_raw()
-                .map_err(|e| OutputError::Foxglove {
-                    path: PathBuf::new(),
-                    message: format!("channel {topic}: {e}"),
+                .map_err(|source| OutputError::Channel {
+                    topic: topic.to_owned(),
+                    source,
                 })
         };
         let numbers = json!({"type": "array", "items": {"type": "number"}});
@@ -369,15 +362,15 @@ fn open_mcap(
     path: &Path,
     urdf: &str,
 ) -> Result<McapWriterHandle<BufWriter<File>>, OutputError> {
-    let failed = |message: String| OutputError::Foxglove {
+    let failed = |source| OutputError::Mcap {
         path: path.to_owned(),
-        message,
+        source,
     };
     let options = McapWriteOptions::default().compression(Some(McapCompression::Lz4));
     let writer = context
         .mcap_writer_with_options(options)
         .create_new_buffered_file(path)
-        .map_err(|e| failed(e.to_string()))?;
+        .map_err(failed)?;
     writer
         .attach(&foxglove::McapAttachment {
             log_time: 0,
@@ -386,7 +379,7 @@ fn open_mcap(
             media_type: "application/xml".into(),
             data: urdf.as_bytes().into(),
         })
-        .map_err(|e| failed(e.to_string()))?;
+        .map_err(failed)?;
     Ok(writer)
 }
 

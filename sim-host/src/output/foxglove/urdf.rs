@@ -9,6 +9,7 @@ use mujoco_rs::prelude::MjModel;
 use mujoco_rs::wrappers::mj_model::MjtGeomBase as MjtGeom;
 
 use super::bodies::{Pose, RobotTree};
+use crate::robot::rotation::rpy_rad;
 
 /// The URDF text of `tree` in `model`, named `name`.
 pub fn urdf(model: &MjModel, tree: &RobotTree, name: &str) -> String {
@@ -129,16 +130,8 @@ fn visual(out: &mut String, model: &MjModel, geom: usize) {
 /// `<origin>` of `pose`: URDF's fixed-axis roll, pitch, yaw.
 fn origin(pose: &Pose) -> String {
     let [x, y, z] = pose.translation_m;
-    let [roll, pitch, yaw] = rpy(pose.rotation_wxyz);
+    let [roll, pitch, yaw] = rpy_rad(pose.rotation_wxyz);
     format!("<origin xyz=\"{x} {y} {z}\" rpy=\"{roll} {pitch} {yaw}\"/>")
-}
-
-/// Roll, pitch, yaw (URDF's `R = Rz(yaw) Ry(pitch) Rx(roll)`) of a unit quaternion.
-pub fn rpy([w, x, y, z]: [f64; 4]) -> [f64; 3] {
-    let roll = (2.0 * (w * x + y * z)).atan2(1.0 - 2.0 * (x * x + y * y));
-    let pitch = (2.0 * (w * y - z * x)).clamp(-1.0, 1.0).asin();
-    let yaw = (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z));
-    [roll, pitch, yaw]
 }
 
 /// `text` safe inside an XML attribute.

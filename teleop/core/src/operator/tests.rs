@@ -247,7 +247,7 @@ fn a_new_latch_or_a_new_session_drops_a_release_on_its_way() {
 }
 
 #[test]
-fn sticks_drive_at_the_modes_limits_and_a_moving_stick_sends_at_most_every_10_ms() {
+fn sticks_drive_at_the_modes_limits_and_ride_on_the_50_hz_command() {
     let mut op = Operator::new();
     let mut ctl = FakeController::new();
     op.observe(&ctl.announce());
@@ -267,13 +267,13 @@ fn sticks_drive_at_the_modes_limits_and_a_moving_stick_sends_at_most_every_10_ms
     assert_eq!(command.mode, TeleopMode::Drive);
     assert!((command.speed.si() - 0.24).abs() < 1e-3, "{command:?}");
     assert!((command.yaw_rate.si() + 1.0).abs() < 1e-3, "{command:?}");
-    // A stick moving every ms: a command every 10 ms, the last position each time.
+    // A stick moving every ms adds no frame: its position rides on the 50 Hz command.
     let mut commands = Vec::new();
-    for t in 2..12 {
+    for t in 2..21 {
         op.press(
             t,
             Action::Sticks {
-                forward: t as f32 / 20.0,
+                forward: t as f32 / 40.0,
                 turn: 0.0,
             },
         );
@@ -284,12 +284,12 @@ fn sticks_drive_at_the_modes_limits_and_a_moving_stick_sends_at_most_every_10_ms
         }
     }
     assert_eq!(commands.len(), 1, "{commands:?}");
-    assert_eq!(commands[0].0, 11);
-    assert!((commands[0].1 - 11.0 / 20.0 * 0.48).abs() < 1e-3);
+    assert_eq!(commands[0].0, 20);
+    assert!((commands[0].1 - 20.0 / 40.0 * 0.48).abs() < 1e-3);
     // In walk the same stick asks for the trot's limits; in the report's keys, no speed.
-    op.press(12, Action::Mode(TeleopMode::Walk));
-    assert!((op.velocity().0 - 11.0 / 20.0 * 0.145).abs() < 1e-6);
-    op.press(12, Action::Mode(TeleopMode::WheelForward));
+    op.press(21, Action::Mode(TeleopMode::Walk));
+    assert!((op.velocity().0 - 20.0 / 40.0 * 0.145).abs() < 1e-6);
+    op.press(21, Action::Mode(TeleopMode::WheelForward));
     assert_eq!(op.velocity(), (0.0, 0.0));
 }
 
