@@ -43,8 +43,8 @@ def main(path):
                         }
                     )
         joints = None
-        for _, _, message in reader.iter_messages(topics=["/joint_states"]):
-            joints = json.loads(message.data)["name"]
+        for _, _, _, decoded in reader.iter_decoded_messages(topics=["/joint_states"]):
+            joints = list(decoded.name)
             break
     json.dump(
         {

@@ -3,21 +3,23 @@
 //!
 //! | topic | schema | what |
 //! |---|---|---|
-//! | `/tf` | `foxglove.FrameTransforms` | `world` → the torso from MuJoCo's free joint, and every link from its joint angle ([`bodies`]) |
-//! | `/joint_states` | JSON `JointState` | every hinge's angle, rate and actuator effort, from MuJoCo |
-//! | `/imu` | JSON `Imu` | what the IMU node sent: angular rate, specific force |
-//! | `/wheels` | JSON `WheelFeedback` | what the wheel drive sent: speed and torque of each wheel |
-//! | `/controller/status` | JSON `ControllerStatus` | the controller's mode, faults, pitch, roll, body height |
+//! | `/tf` | `foxglove.FrameTransforms` | `world` → the torso from MuJoCo's free joint, and every link from its joint angle ([`bodies`]), at [`TF_HZ`] |
+//! | `/joint_states` | `JointState` | every hinge's angle, rate and actuator effort, from MuJoCo, at [`JOINTS_HZ`] |
+//! | `/imu` | `Imu` | what the IMU node sent: angular rate, specific force |
+//! | `/wheels` | `WheelFeedback` | what the wheel drive sent: speed and torque of each wheel |
+//! | `/controller/status` | `ControllerStatus` | the controller's mode, faults, pitch, roll, body height |
 //! | `/controller/log` | `foxglove.Log` | a line per change of mode or fault flags |
-//! | `/can` | JSON `CanFrame` | every frame on the bus: id, message name, data |
+//! | `/can` | `CanFrames` | every frame on the bus (id, message name, data), a message per control cycle |
 //! | `/robot_description` | JSON `std_msgs/String` | the URDF (also attached to the MCAP, and `robot.urdf` beside it) |
 //! | `/camera` | `foxglove.CompressedImage` | the rendered frames, PNG (only with frames: feature `renderer`) |
 //!
-//! Log times are simulation time. The MCAP is lz4-chunked and flushed with the other logs (at
+//! The log's own messages ([`messages`]) are protobuf with their schemas in the file. Log times
+//! are simulation time. The MCAP is lz4-chunked and flushed with the other logs (at
 //! least once a second), so a killed run leaves it readable up to its last flush (MCAP readers
 //! recover the chunks of a file without a footer).
 
 pub mod bodies;
+pub mod messages;
 pub mod urdf;
 
 use std::fs::File;
@@ -65,6 +67,10 @@ pub struct FoxgloveLog {
     /// When the description was last logged, s (repeated so that a late viewer gets it).
     described_s: Option<f64>,
     camera: Option<Arc<Channel<CompressedImage>>>,
+    tf_due: Due,
+    joints_due: Due,
+    /// The frames seen since the last cycle, and when the last was.
+    pending_can: (Vec<messages::CanFrame>, f64),
 }
 
 impl std::fmt::Debug for FoxgloveLog {
@@ -82,16 +88,43 @@ impl std::fmt::Debug for FoxgloveLog {
 struct Channels {
     tf: Channel<FrameTransforms>,
     log: Channel<Log>,
-    joints: Arc<RawChannel>,
-    imu: Arc<RawChannel>,
-    wheels: Arc<RawChannel>,
-    status: Arc<RawChannel>,
-    can: Arc<RawChannel>,
+    joints: Channel<messages::JointState>,
+    imu: Channel<messages::Imu>,
+    wheels: Channel<messages::WheelFeedback>,
+    status: Channel<messages::ControllerStatus>,
+    can: Channel<messages::CanFrames>,
     description: Arc<RawChannel>,
 }
 
-/// The robot description is logged again this often, s.
+/// The robot description is logged again this often, s (repeated so that a late viewer gets it).
 const DESCRIBE_EVERY_S: f64 = 1.0;
+
+/// The transforms' rate, Hz: smooth in a 3D view, and a fifth of the data the control rate's
+/// would be (23 transforms a message are most of the file).
+pub const TF_HZ: f64 = 50.0;
+
+/// The joint states' rate, Hz: half the control rate of 250 Hz, for plots.
+pub const JOINTS_HZ: f64 = 125.0;
+
+/// When a decimated topic is next due, s.
+#[derive(Debug, Clone, Copy, Default)]
+struct Due {
+    next_s: Option<f64>,
+}
+
+impl Due {
+    /// Whether a message at `time_s` is due at `rate_hz`; if so the next is a period on.
+    fn now(&mut self, time_s: f64, rate_hz: f64) -> bool {
+        // A little slack, so that 4 ms steps land on a 20 ms grid despite rounding.
+        if self.next_s.is_some_and(|next| time_s + 1e-4 < next) {
+            return false;
+        }
+        let period_s = 1.0 / rate_hz;
+        let base = self.next_s.unwrap_or(time_s);
+        self.next_s = Some(base.max(time_s - period_s) + period_s);
+        true
+    }
+}
 
 impl FoxgloveLog {
     /// Opens the outputs of `outputs` for the robot of `sim`; `None` when there are none.
@@ -130,6 +163,9 @@ impl FoxgloveLog {
             last_status: None,
             described_s: None,
             camera: None,
+            tf_due: Due::default(),
+            joints_due: Due::default(),
+            pending_can: (Vec::with_capacity(32), 0.0),
         }))
     }
 
@@ -154,31 +190,34 @@ impl FoxgloveLog {
 
     /// Logs one frame seen on the bus at `time_s`, and what it says where a topic shows it.
     pub fn frame(&mut self, time_s: f64, frame: &Frame) {
-        let at = meta(time_s);
         let decoded = decode_frame(frame.id(), frame.data()).ok();
         let name = protocol::MessageId::from_raw(frame.id()).map(|id| id.layout().name);
-        let can = json!({
-            "id": frame.id(),
-            "name": name.unwrap_or("unknown"),
-            "data": hex(frame.data()),
+        self.pending_can.0.push(messages::CanFrame {
+            id: u32::from(frame.id()),
+            name: name.unwrap_or("unknown"),
+            data: foxglove::bytes::Bytes::copy_from_slice(frame.data()),
         });
-        log_json(&self.channels.can, &can, at);
+        self.pending_can.1 = time_s;
+        let at = nanos(time_s);
         match decoded.map(|d| d.message) {
             Some(AnyMessage::Imu(imu)) => {
-                let [gx, gy, gz] = imu.angular_rate.map(|r| r.si());
-                let [ax, ay, az] = imu.acceleration.map(|a| a.si());
-                let message = json!({
-                    "angular_velocity": {"x": gx, "y": gy, "z": gz},
-                    "linear_acceleration": {"x": ax, "y": ay, "z": az},
-                });
-                log_json(&self.channels.imu, &message, at);
+                let vector = |[x, y, z]: [f32; 3]| messages::Vector {
+                    x: f64::from(x),
+                    y: f64::from(y),
+                    z: f64::from(z),
+                };
+                let message = messages::Imu {
+                    angular_velocity: vector(imu.angular_rate.map(|r| r.si())),
+                    linear_acceleration: vector(imu.acceleration.map(|a| a.si())),
+                };
+                self.channels.imu.log_with_time(&message, at);
             }
             Some(AnyMessage::WheelFeedback(wheels)) => {
-                let message = json!({
-                    "velocity_rad_s": wheels.velocity.map(|v| v.si()),
-                    "effort_nm": wheels.effort.map(|e| e.si()),
-                });
-                log_json(&self.channels.wheels, &message, at);
+                let message = messages::WheelFeedback {
+                    velocity_rad_s: wheels.velocity.map(|v| f64::from(v.si())),
+                    effort_nm: wheels.effort.map(|e| f64::from(e.si())),
+                };
+                self.channels.wheels.log_with_time(&message, at);
             }
             Some(AnyMessage::ControllerStatus(status)) => self.status(time_s, &status),
             _ => {}
@@ -187,20 +226,20 @@ impl FoxgloveLog {
 
     fn status(&mut self, time_s: f64, status: &protocol::ControllerStatus) {
         let bits = status.faults.bits();
-        let faults: Vec<&str> = FaultFlags::FLAGS
+        let faults: Vec<&'static str> = FaultFlags::FLAGS
             .iter()
             .enumerate()
             .filter(|(bit, _)| bits & (1 << bit) != 0)
             .map(|(_, name)| *name)
             .collect();
-        let message = json!({
-            "mode": status.mode.label(),
-            "faults": faults,
-            "pitch_rad": status.pitch.si(),
-            "roll_rad": status.roll.si(),
-            "body_height_m": status.body_height.si(),
-        });
-        log_json(&self.channels.status, &message, meta(time_s));
+        let message = messages::ControllerStatus {
+            mode: status.mode.label(),
+            faults: faults.clone(),
+            pitch_rad: f64::from(status.pitch.si()),
+            roll_rad: f64::from(status.roll.si()),
+            body_height_m: f64::from(status.body_height.si()),
+        };
+        self.channels.status.log_with_time(&message, nanos(time_s));
         let now = (status.mode, status.faults);
         if self.last_status != Some(now) {
             self.last_status = Some(now);
@@ -229,29 +268,15 @@ impl FoxgloveLog {
 
     /// Logs the robot's pose and joints at the simulator's present step.
     pub fn cycle(&mut self, sim: &Simulator) {
+        self.log_can();
         let time_s = sim.time_s();
         let data = sim.physics().data();
-        let stamp = Some(timestamp(time_s));
-        let mut transforms = Vec::with_capacity(self.tree.links.len() + 1);
-        if let Some(root) = self.tree.root_pose(data.qpos()) {
-            transforms.push(transform(stamp, WORLD_FRAME, &self.tree.root, &root));
+        if self.tf_due.now(time_s, TF_HZ) {
+            self.transforms(time_s, data.qpos());
         }
-        for link in &self.tree.links {
-            let pose = RobotTree::link_pose(link, data.qpos());
-            transforms.push(transform(stamp, &link.parent, &link.name, &pose));
+        if self.joints_due.now(time_s, JOINTS_HZ) {
+            self.joint_states(time_s, sim);
         }
-        self.channels
-            .tf
-            .log_with_time(&FrameTransforms { transforms }, nanos(time_s));
-        let (qpos, qvel, effort) = (data.qpos(), data.qvel(), data.qfrc_actuator());
-        let hinges: Vec<_> = self.tree.hinges().collect();
-        let joints = json!({
-            "name": hinges.iter().map(|h| h.name.as_str()).collect::<Vec<_>>(),
-            "position": hinges.iter().map(|h| qpos.get(h.qpos).copied().unwrap_or(0.0)).collect::<Vec<_>>(),
-            "velocity": hinges.iter().map(|h| qvel.get(h.dof).copied().unwrap_or(0.0)).collect::<Vec<_>>(),
-            "effort": hinges.iter().map(|h| effort.get(h.dof).copied().unwrap_or(0.0)).collect::<Vec<_>>(),
-        });
-        log_json(&self.channels.joints, &joints, meta(time_s));
         if self
             .described_s
             .is_none_or(|at| time_s - at >= DESCRIBE_EVERY_S)
@@ -263,6 +288,46 @@ impl FoxgloveLog {
                 meta(time_s),
             );
         }
+    }
+
+    /// Logs the frames seen since the last cycle as one `/can` message.
+    fn log_can(&mut self) {
+        if self.pending_can.0.is_empty() {
+            return;
+        }
+        let frames = std::mem::replace(&mut self.pending_can.0, Vec::with_capacity(32));
+        self.channels
+            .can
+            .log_with_time(&messages::CanFrames { frames }, nanos(self.pending_can.1));
+    }
+
+    fn transforms(&self, time_s: f64, qpos: &[f64]) {
+        let stamp = Some(timestamp(time_s));
+        let mut transforms = Vec::with_capacity(self.tree.links.len() + 1);
+        if let Some(root) = self.tree.root_pose(qpos) {
+            transforms.push(transform(stamp, WORLD_FRAME, &self.tree.root, &root));
+        }
+        for link in &self.tree.links {
+            let pose = RobotTree::link_pose(link, qpos);
+            transforms.push(transform(stamp, &link.parent, &link.name, &pose));
+        }
+        self.channels
+            .tf
+            .log_with_time(&FrameTransforms { transforms }, nanos(time_s));
+    }
+
+    fn joint_states(&self, time_s: f64, sim: &Simulator) {
+        let data = sim.physics().data();
+        let (qpos, qvel, effort) = (data.qpos(), data.qvel(), data.qfrc_actuator());
+        let hinges: Vec<_> = self.tree.hinges().collect();
+        let value = |values: &[f64], at: usize| values.get(at).copied().unwrap_or(0.0);
+        let joints = messages::JointState {
+            name: hinges.iter().map(|h| h.name.clone()).collect(),
+            position: hinges.iter().map(|h| value(qpos, h.qpos)).collect(),
+            velocity: hinges.iter().map(|h| value(qvel, h.dof)).collect(),
+            effort: hinges.iter().map(|h| value(effort, h.dof)).collect(),
+        };
+        self.channels.joints.log_with_time(&joints, nanos(time_s));
     }
 
     /// Puts what was logged so far into the file.
@@ -278,6 +343,7 @@ impl FoxgloveLog {
 
     /// Closes the file (its summary and index written) and stops the live server.
     pub fn finish(mut self) -> Result<(), OutputError> {
+        self.log_can();
         if let Some(server) = self.server.take() {
             server.stop().wait_blocking();
         }
@@ -312,41 +378,14 @@ impl Channels {
                     source,
                 })
         };
-        let numbers = json!({"type": "array", "items": {"type": "number"}});
-        let strings = json!({"type": "array", "items": {"type": "string"}});
-        let vector = json!({"type": "object", "properties": {
-            "x": {"type": "number"}, "y": {"type": "number"}, "z": {"type": "number"}}});
         Ok(Self {
             tf: context.channel_builder("/tf").build(),
             log: context.channel_builder("/controller/log").build(),
-            joints: json(
-                "/joint_states",
-                "JointState",
-                json!({"name": strings, "position": numbers, "velocity": numbers, "effort": numbers}),
-            )?,
-            imu: json(
-                "/imu",
-                "Imu",
-                json!({"angular_velocity": vector, "linear_acceleration": vector}),
-            )?,
-            wheels: json(
-                "/wheels",
-                "WheelFeedback",
-                json!({"velocity_rad_s": numbers, "effort_nm": numbers}),
-            )?,
-            status: json(
-                "/controller/status",
-                "ControllerStatus",
-                json!({"mode": {"type": "string"}, "faults": strings,
-                    "pitch_rad": {"type": "number"}, "roll_rad": {"type": "number"},
-                    "body_height_m": {"type": "number"}}),
-            )?,
-            can: json(
-                "/can",
-                "CanFrame",
-                json!({"id": {"type": "integer"}, "name": {"type": "string"},
-                    "data": {"type": "string"}}),
-            )?,
+            joints: context.channel_builder("/joint_states").build(),
+            imu: context.channel_builder("/imu").build(),
+            wheels: context.channel_builder("/wheels").build(),
+            status: context.channel_builder("/controller/status").build(),
+            can: context.channel_builder("/can").build(),
             description: json(
                 "/robot_description",
                 "std_msgs/String",
@@ -367,9 +406,15 @@ fn open_mcap(
         source,
     };
     let options = McapWriteOptions::default().compression(Some(McapCompression::Lz4));
+    // Replaced, as the run's other logs are: a second run into the same folder is the usual
+    // case (the demo's `out/`).
+    let file = File::create(path).map_err(|source| OutputError::Io {
+        path: path.to_owned(),
+        source,
+    })?;
     let writer = context
         .mcap_writer_with_options(options)
-        .create_new_buffered_file(path)
+        .create(BufWriter::new(file))
         .map_err(failed)?;
     writer
         .attach(&foxglove::McapAttachment {
@@ -426,6 +471,26 @@ pub fn timestamp(time_s: f64) -> Timestamp {
     Timestamp::new((ns / 1_000_000_000) as u32, (ns % 1_000_000_000) as u32)
 }
 
-fn hex(bytes: &[u8]) -> String {
-    bytes.iter().map(|b| format!("{b:02X}")).collect()
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_decimated_topic_keeps_its_rate_on_a_control_grid() {
+        let mut due = Due::default();
+        // 250 Hz for 2 s at 50 Hz: every fifth step, 100 in all.
+        let logged: Vec<usize> = (1..=500)
+            .filter(|&k| due.now(k as f64 * 0.004, 50.0))
+            .collect();
+        assert_eq!(logged.len(), 100);
+        assert!(logged.windows(2).all(|w| w[1] - w[0] == 5), "{logged:?}");
+        // 125 Hz from 250 Hz: every other step.
+        let mut due = Due::default();
+        assert_eq!(
+            (1..=500)
+                .filter(|&k| due.now(k as f64 * 0.004, 125.0))
+                .count(),
+            250
+        );
+    }
 }
