@@ -8,7 +8,6 @@ mod common;
 use std::collections::BTreeMap;
 use std::net::TcpListener;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::time::{Duration, Instant};
 
 use common::config;
@@ -22,18 +21,6 @@ use sim_host::robot::plant::Plant;
 use sim_host::robot::rotation::rpy_rad;
 use sim_host::session;
 use teleop_core::scripted::PlanStep;
-
-fn python() -> PathBuf {
-    let python = std::env::var_os("PROTOCOL_PYTHON")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../.venv/bin/python"));
-    assert!(
-        python.exists(),
-        "no Python with mcap at {}: run `cargo xtask setup` (or set PROTOCOL_PYTHON)",
-        python.display()
-    );
-    python
-}
 
 /// Stand, then a steered trot: every link moves.
 fn plan() -> Vec<PlanStep> {
@@ -57,17 +44,7 @@ fn the_mcap_opens_in_an_independent_reader_with_every_channel_and_mujocos_torso_
     let mut cfg = config(Plant::default(), plan(), Vec::new(), 4.0);
     cfg.out_dir = Some(dir.clone());
     let report = session::run(&cfg).unwrap();
-    let output = Command::new(python())
-        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/read_mcap.py"))
-        .arg(dir.join("run.mcap"))
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "the Python reader failed:\n{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let read: serde_json::Value = serde_json::from_slice(&output.stdout).unwrap();
+    let read = common::read_mcap(&dir.join("run.mcap"));
     let channels: BTreeMap<String, (String, String, u64)> = read["channels"]
         .as_array()
         .unwrap()

@@ -176,28 +176,14 @@ fn frames_reach_the_mcap() {
     });
     let report = sim_host::session::run(&config).unwrap();
     assert_eq!(report.frames.len(), 6, "frames at 0, 0.2, … 1.0 s");
-    let python = std::env::var_os("PROTOCOL_PYTHON")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../.venv/bin/python"));
-    let output = std::process::Command::new(python)
-        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/read_mcap.py"))
-        .arg(out.join("run.mcap"))
-        .output()
-        .unwrap();
-    assert!(
-        output.status.success(),
-        "{}",
-        String::from_utf8_lossy(&output.stderr)
-    );
-    let text = String::from_utf8_lossy(&output.stdout);
-    let camera = text
-        .split("{\"topic\": ")
-        .find(|c| c.starts_with("\"/camera\""))
-        .unwrap_or_else(|| panic!("no /camera channel: {text}"));
-    assert!(
-        camera.contains("\"schema\": \"foxglove.CompressedImage\""),
-        "{camera}"
-    );
-    assert!(camera.contains("\"count\": 6}"), "{camera}");
+    let read = common::read_mcap(&out.join("run.mcap"));
+    let camera = read["channels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["topic"] == "/camera")
+        .unwrap_or_else(|| panic!("no /camera channel: {read}"));
+    assert_eq!(camera["schema"], "foxglove.CompressedImage", "{camera}");
+    assert_eq!(camera["count"], 6, "{camera}");
     let _ = std::fs::remove_dir_all(&out);
 }

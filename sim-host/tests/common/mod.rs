@@ -11,6 +11,31 @@ use sim_host::session::{BusChoice, Clock, SegmentSpec, SessionConfig};
 use teleop_core::scenario::{mode_name, parse_mode, Scenario};
 use teleop_core::scripted::PlanStep;
 
+/// The MCAP file at `path` as the official Python reader (the project venv's `mcap`) reads it:
+/// `tests/python/read_mcap.py`'s JSON (channels with schemas and counts, attachments, the
+/// `world` → `torso` transforms, the joints' names).
+pub fn read_mcap(path: &Path) -> serde_json::Value {
+    let python = std::env::var_os("PROTOCOL_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../.venv/bin/python"));
+    assert!(
+        python.exists(),
+        "no Python with mcap at {}: run `cargo xtask setup` (or set PROTOCOL_PYTHON)",
+        python.display()
+    );
+    let output = std::process::Command::new(python)
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/python/read_mcap.py"))
+        .arg(path)
+        .output()
+        .unwrap();
+    assert!(
+        output.status.success(),
+        "the Python reader failed:\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).unwrap()
+}
+
 /// An acceptance scenario file by name.
 pub fn scenario_file(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))

@@ -246,20 +246,21 @@ fn a_new_latch_or_a_new_session_drops_a_release_on_its_way() {
     assert_eq!(later, 0, "no release into a new session");
 }
 
-#[test]
-fn sticks_drive_at_the_modes_limits_and_ride_on_the_50_hz_command() {
+/// An operator in the controller's session who pressed `drive` at 1 ms and holds the sticks at
+/// `forward` and `turn`.
+fn driving(forward: f32, turn: f32) -> (Operator, FakeController) {
     let mut op = Operator::new();
     let mut ctl = FakeController::new();
     op.observe(&ctl.announce());
     ctl.decode(&op.poll(0).unwrap());
     op.press(1, Action::Mode(TeleopMode::Drive));
-    op.press(
-        1,
-        Action::Sticks {
-            forward: 0.5,
-            turn: -1.0,
-        },
-    );
+    op.press(1, Action::Sticks { forward, turn });
+    (op, ctl)
+}
+
+#[test]
+fn sticks_drive_at_the_modes_limits_and_ride_on_the_50_hz_command() {
+    let (mut op, mut ctl) = driving(0.5, -1.0);
     let sent = ctl.decode(&op.poll(1).unwrap());
     let [AnyMessage::TeleopCommand(command)] = sent.as_slice() else {
         panic!("{sent:?}");
@@ -295,18 +296,7 @@ fn sticks_drive_at_the_modes_limits_and_ride_on_the_50_hz_command() {
 
 #[test]
 fn a_lost_pad_sends_stop_then_silence_and_its_return_resumes_the_heartbeat() {
-    let mut op = Operator::new();
-    let mut ctl = FakeController::new();
-    op.observe(&ctl.announce());
-    ctl.decode(&op.poll(0).unwrap());
-    op.press(1, Action::Mode(TeleopMode::Drive));
-    op.press(
-        1,
-        Action::Sticks {
-            forward: 1.0,
-            turn: 0.0,
-        },
-    );
+    let (mut op, mut ctl) = driving(1.0, 0.0);
     ctl.decode(&op.poll(1).unwrap());
     op.press(5, Action::InputLost);
     let sent = ctl.decode(&op.poll(5).unwrap());
