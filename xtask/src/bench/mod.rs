@@ -1,5 +1,7 @@
 //! `cargo xtask bench`: the criterion benchmarks, then a table of their medians, printed and
-//! written into docs/measurements.md between the `bench:begin` and `bench:end` markers.
+//! written into docs/measurements.md between the `bench:begin` and `bench:end` markers; then
+//! `sim-host run` beside the report's loop in Python ([`whole_run`]), between `bench-run:begin`
+//! and `bench-run:end`.
 //!
 //! Timings on shared machines are noisy: compare figures within one run (the ratio of the
 //! typed step to the full CAN node, of the closed loop to raw MuJoCo), not against a fixed
@@ -9,8 +11,12 @@ use std::fs;
 
 use crate::util::{cargo, root, run};
 
+mod whole_run;
+
 const BEGIN: &str = "<!-- bench:begin -->";
 const END: &str = "<!-- bench:end -->";
+const RUN_BEGIN: &str = "<!-- bench-run:begin -->";
+const RUN_END: &str = "<!-- bench-run:end -->";
 /// The page the table of medians is written into, relative to the workspace root.
 const PAGE: &str = "docs/measurements.md";
 
@@ -80,7 +86,15 @@ pub fn run_task(args: &[String]) -> Result<(), String> {
         _ => None,
     };
     let table = markdown_table(&rows, summary.as_deref());
-    crate::faults::write_section(&root().join(PAGE), BEGIN, END, &table, false, "bench")
+    crate::faults::write_section(&root().join(PAGE), BEGIN, END, &table, false, "bench")?;
+    let raw_steps_per_s = match medians[..] {
+        [.., raw, _] => 1e9 / raw,
+        _ => return Err("no MuJoCo step median".into()),
+    };
+    let measured = whole_run::measure()?;
+    let comparison = whole_run::markdown(&measured, raw_steps_per_s);
+    println!("\n{comparison}");
+    crate::faults::write_section(&root().join(PAGE), RUN_BEGIN, RUN_END, &comparison, false, "bench")
 }
 
 /// The printed table as Markdown: one row per benchmark (`(name, median in ns, what it
