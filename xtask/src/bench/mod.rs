@@ -94,7 +94,14 @@ pub fn run_task(args: &[String]) -> Result<(), String> {
     let measured = whole_run::measure()?;
     let comparison = whole_run::markdown(&measured, raw_steps_per_s);
     println!("\n{comparison}");
-    crate::faults::write_section(&root().join(PAGE), RUN_BEGIN, RUN_END, &comparison, false, "bench")
+    crate::faults::write_section(
+        &root().join(PAGE),
+        RUN_BEGIN,
+        RUN_END,
+        &comparison,
+        false,
+        "bench",
+    )
 }
 
 /// The printed table as Markdown: one row per benchmark (`(name, median in ns, what it

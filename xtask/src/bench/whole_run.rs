@@ -40,16 +40,20 @@ pub(super) fn measure() -> Result<WholeRun, String> {
     for _ in 0..RUNS {
         let mut command = Command::new(&sim_host);
         command
-            .args(["run", "--drive", "0:stand", "--drive", "1:L", "--no-progress"])
+            .args([
+                "run",
+                "--drive",
+                "0:stand",
+                "--drive",
+                "1:L",
+                "--no-progress",
+            ])
             .args(["--duration-s", &SECONDS.to_string(), "--out"])
             .arg(&out);
         let (process_s, stdout) = timed(&mut command)?;
         sim.push((process_s, steps / sim_loop_s(&stdout)?));
         let mut command = Command::new(&python);
-        command
-            .arg(&script)
-            .arg(&model)
-            .arg(SECONDS.to_string());
+        command.arg(&script).arg(&model).arg(SECONDS.to_string());
         let (process_s, stdout) = timed(&mut command)?;
         py.push((process_s, python_steps_per_s(&stdout)?));
     }
@@ -84,9 +88,7 @@ pub(super) fn markdown(run: &WholeRun, raw_steps_per_s: f64) -> String {
 /// Runs `command`, returning its wall time, s, and its standard output.
 fn timed(command: &mut Command) -> Result<(f64, String), String> {
     let started = Instant::now();
-    let output = command
-        .output()
-        .map_err(|e| format!("{command:?}: {e}"))?;
+    let output = command.output().map_err(|e| format!("{command:?}: {e}"))?;
     let elapsed = started.elapsed().as_secs_f64();
     if !output.status.success() {
         return Err(format!(
@@ -94,7 +96,10 @@ fn timed(command: &mut Command) -> Result<(f64, String), String> {
             String::from_utf8_lossy(&output.stderr)
         ));
     }
-    Ok((elapsed, String::from_utf8_lossy(&output.stdout).into_owned()))
+    Ok((
+        elapsed,
+        String::from_utf8_lossy(&output.stdout).into_owned(),
+    ))
 }
 
 /// The loop's wall time from `sim-host run`'s report line `simulated 120.00 s in 1.07 s wall …`.
