@@ -67,14 +67,63 @@ pub fn recorded_ticks() -> Result<Vec<Frames>, String> {
     Ok(load_recording()?.ticks)
 }
 
-/// The committed recording.
+/// The committed recording, refused when a frame of it does not decode under this build's
+/// wire contract: a recording made before a layout changed would feed both builds frames they
+/// reject, and their agreement would show nothing.
 fn load_recording() -> Result<Recording, String> {
     let path = root().join(RECORDING);
     let bytes = std::fs::read(&path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
-    Recording::from_compact(&bytes).map_err(|e| {
+    let recording = Recording::from_compact(&bytes).map_err(|e| {
         format!(
             "{}: {e} (regenerate: cargo xtask pil --record)",
             path.display()
         )
+    })?;
+    stale_frame(&recording).map_or(Ok(recording), |(tick, id, error)| {
+        Err(format!(
+            "{}: tick {tick}, frame 0x{id:03X} does not decode under wire version {}: {error:?} \
+             (the recording predates a change of the wire contract; regenerate: cargo xtask pil \
+             --record)",
+            path.display(),
+            protocol::WIRE_VERSION
+        ))
     })
+}
+
+/// The first frame of `recording` this build's protocol refuses to decode: its tick, its
+/// identifier and why.
+fn stale_frame(recording: &Recording) -> Option<(usize, u16, protocol::DecodeError)> {
+    recording
+        .ticks
+        .iter()
+        .enumerate()
+        .find_map(|(tick, frames)| {
+            frames.iter().find_map(|(id, data)| {
+                protocol::decode_frame(*id, data)
+                    .err()
+                    .map(|error| (tick, *id, error))
+            })
+        })
+}
+
+#[cfg(test)]
+mod stale_tests {
+    use super::*;
+
+    #[test]
+    fn a_frame_of_another_layout_marks_the_recording_stale() {
+        // A 12-byte operator command: wire version 7's layout, 16 bytes since version 8.
+        let recording = Recording {
+            control_hz: 250,
+            first_tick: 0,
+            ticks: vec![vec![], vec![(0x200, vec![0; 12])]],
+        };
+        let (tick, id, _) = stale_frame(&recording).unwrap();
+        assert_eq!((tick, id), (1, 0x200));
+        let fresh = Recording {
+            ticks: vec![vec![]],
+            ..recording
+        };
+        assert!(stale_frame(&fresh).is_none());
+    }
 }
