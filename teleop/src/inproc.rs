@@ -28,6 +28,9 @@ pub struct InprocOptions {
     pub clock: Clock,
     /// Longest run, simulated s.
     pub duration_s: f64,
+    /// Serve the simulated robot live to Foxglove on this WebSocket port of 127.0.0.1 (`None`:
+    /// no server).
+    pub foxglove_port: Option<u16>,
 }
 
 impl InprocOptions {
@@ -38,6 +41,7 @@ impl InprocOptions {
             out_dir: None,
             clock: Clock::Wall,
             duration_s: 86_400.0,
+            foxglove_port: None,
         }
     }
 }
@@ -76,7 +80,7 @@ impl InprocRobot {
             segments: Vec::new(),
             frames: None,
             viewer: false,
-            live_port: None,
+            live_port: options.foxglove_port,
             attach: Some(attach),
             faults: Default::default(),
         };

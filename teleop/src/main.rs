@@ -43,6 +43,10 @@ struct Cli {
     /// With `--bus inproc`: write telemetry.csv, bus.log and plots here when teleop ends.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// With `--bus inproc`: serve the simulated robot live to the Foxglove app on this
+    /// WebSocket port of 127.0.0.1 (as `sim-host run --foxglove-port`).
+    #[arg(long, value_name = "PORT")]
+    foxglove_port: Option<u16>,
     /// The bus key: a file holding 32 hexadecimal digits, readable by this account only (as
     /// firmware-host's). Without it, the public test key of simulation and CI.
     #[arg(long, value_name = "PATH")]
@@ -156,9 +160,11 @@ fn run(cli: Cli) -> Result<(), Failure> {
         }
         return inproc(&cli, scenario.as_ref(), &stop);
     }
-    if cli.model.is_some() || cli.out.is_some() {
+    if cli.model.is_some() || cli.out.is_some() || cli.foxglove_port.is_some() {
         return Err(Failure::usage(
-            "--model and --out belong to --bus inproc (on a CAN bus the robot is elsewhere)".into(),
+            "--model, --out and --foxglove-port belong to --bus inproc (on a CAN bus the robot is \
+             elsewhere)"
+                .into(),
         ));
     }
     let key = host_can::key_file::load(cli.key_file.as_deref())
@@ -310,6 +316,7 @@ fn inproc(cli: &Cli, scenario: Option<&Scenario>, stop: &AtomicBool) -> Result<(
         options.model = model.clone();
     }
     options.out_dir = cli.out.clone();
+    options.foxglove_port = cli.foxglove_port;
     let (robot, mut endpoint) = InprocRobot::start(options);
     // A simulator that fails (a bad model, say) ends the session; its error is shown below.
     let mut live = || {
