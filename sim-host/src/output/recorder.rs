@@ -1,39 +1,36 @@
-//! Collects what a run leaves behind: every frame on the bus streamed to a candump log, every
-//! telemetry row streamed to a CSV file and kept in memory for the plots drawn at the end.
+//! Collects what a run leaves behind: every frame on the bus for the candump log, every
+//! telemetry row for the CSV file (and kept in bounded memory for the plots drawn at the end),
+//! and the robot's state for the Foxglove MCAP. The files are written off the simulation's
+//! thread by the [`log_writer`](crate::output::log_writer), started on the first record.
 //!
-//! The logs are on disk as the run goes: both files are flushed at least once a second (wall
-//! clock), so a run that is killed outright leaves them readable up to within a second of the
-//! kill; a run that fails or is stopped flushes them as it ends (dropping the writers flushes
-//! too).
+//! The logs are on disk as the run goes: flushed at least every quarter second (wall clock), so
+//! a run that is killed outright leaves them readable up to within a second of the kill; a run
+//! that fails or is stopped completes them as it ends.
 
-use std::fs::File;
-use std::io::BufWriter;
-use std::path::{Path, PathBuf};
-use std::time::{Duration, Instant};
+use std::path::Path;
 
 use protocol::Frame;
 
 use crate::output::decimated::Decimated;
-use crate::output::foxglove::FoxgloveLog;
+use crate::output::foxglove::{FoxgloveLog, RobotSample};
+use crate::output::log_writer::{LogWriter, Record, Sinks};
 use crate::output::output_error::OutputError;
 use crate::output::telemetry::TelemetryRow;
 use crate::output::telemetry_csv::CsvWriter;
 use crate::session::simulator::Simulator;
-use host_can::candump::{CandumpWriter, LoggedFrame};
+use host_can::candump::CandumpWriter;
 
-/// Longest the logs stay in memory buffers before they are flushed to disk.
-pub const FLUSH_EVERY: Duration = Duration::from_millis(250);
+pub use crate::output::log_writer::FLUSH_EVERY;
 
 /// The recorder of one run.
 #[derive(Debug, Default)]
 pub struct Recorder {
     rows: Decimated<TelemetryRow>,
-    candump: Option<(PathBuf, CandumpWriter<BufWriter<File>>)>,
-    csv: Option<CsvWriter>,
-    last_flush: Option<Instant>,
+    /// The files, until the first record starts their writer.
+    sinks: Option<Sinks>,
+    writer: Option<LogWriter>,
     frames: u64,
     discard_rows: bool,
-    foxglove: Option<FoxgloveLog>,
 }
 
 impl Recorder {
@@ -55,108 +52,91 @@ impl Recorder {
     /// `csv`.
     pub fn with_files(log: &Path, csv: &Path, interface: &str) -> Result<Self, OutputError> {
         let mut recorder = Self::with_candump(log, interface)?;
-        recorder.csv = Some(CsvWriter::create(csv)?);
+        recorder.sinks_mut().csv = Some(CsvWriter::create(csv)?);
         Ok(recorder)
     }
 
     /// A recorder that also writes every frame to `path` in candump format, labelled with
     /// `interface` (so that `canplayer` can replay it there).
     pub fn with_candump(path: &Path, interface: &str) -> Result<Self, OutputError> {
-        let file = File::create(path).map_err(|source| OutputError::Io {
+        let io = |source| OutputError::Io {
             path: path.to_owned(),
             source,
-        })?;
-        let writer = CandumpWriter::new(BufWriter::new(file), interface).map_err(|source| {
-            OutputError::Io {
-                path: path.to_owned(),
-                source,
-            }
-        })?;
-        Ok(Self {
-            candump: Some((path.to_owned(), writer)),
-            last_flush: Some(Instant::now()),
-            ..Self::default()
-        })
+        };
+        let file = std::fs::File::create(path).map_err(io)?;
+        let writer = CandumpWriter::new(std::io::BufWriter::new(file), interface).map_err(io)?;
+        let mut recorder = Self::default();
+        recorder.sinks_mut().candump = Some((path.to_owned(), writer));
+        Ok(recorder)
     }
 
-    /// Also logs to `foxglove` (an MCAP file, a live server).
+    fn sinks_mut(&mut self) -> &mut Sinks {
+        self.sinks.get_or_insert_with(Sinks::default)
+    }
+
+    /// Also logs to `foxglove` (an MCAP file, a live server). Before the first record only.
     pub fn set_foxglove(&mut self, foxglove: FoxgloveLog) {
-        self.last_flush.get_or_insert_with(Instant::now);
-        self.foxglove = Some(foxglove);
+        self.sinks_mut().foxglove = Some(foxglove);
     }
 
-    /// The Foxglove log, if there is one.
-    pub fn foxglove(&self) -> Option<&FoxgloveLog> {
-        self.foxglove.as_ref()
-    }
-
-    /// The Foxglove log, to add a channel to.
+    /// The Foxglove log, to add a channel to, before the first record.
     pub fn foxglove_mut(&mut self) -> Option<&mut FoxgloveLog> {
-        self.foxglove.as_mut()
+        self.sinks
+            .as_mut()
+            .and_then(|sinks| sinks.foxglove.as_mut())
+    }
+
+    /// The writer of the files, started on the first record (`None` without files).
+    fn writer(&mut self) -> Result<Option<&mut LogWriter>, OutputError> {
+        if let Some(sinks) = self.sinks.take().filter(|sinks| !sinks.is_empty()) {
+            self.writer = Some(LogWriter::start(sinks)?);
+        }
+        Ok(self.writer.as_mut())
     }
 
     /// Logs one frame seen on the bus at `time_s`.
     pub fn frame(&mut self, time_s: f64, frame: &Frame) -> Result<(), OutputError> {
         self.frames += 1;
-        if let Some(foxglove) = &mut self.foxglove {
-            foxglove.frame(time_s, frame);
-        }
-        if let Some((path, writer)) = &mut self.candump {
-            writer
-                .write(&LoggedFrame {
-                    time_s,
-                    frame: *frame,
-                })
-                .map_err(|source| OutputError::Io {
-                    path: path.clone(),
-                    source,
-                })?;
+        if let Some(writer) = self.writer()? {
+            writer.push(Record::Frame {
+                time_s,
+                frame: *frame,
+            })?;
         }
         Ok(())
     }
 
-    /// Records the simulator's present step: its telemetry row ([`Recorder::row`]) and, with a
-    /// Foxglove log, the robot's transforms and joints.
+    /// Records the simulator's present step: its telemetry row and, with a Foxglove log, the
+    /// robot's state.
     pub fn cycle(&mut self, sim: &Simulator) -> Result<(), OutputError> {
-        if let Some(foxglove) = &mut self.foxglove {
-            foxglove.cycle(sim);
-        }
-        self.row(sim.telemetry())
+        let foxglove = self
+            .sinks
+            .as_ref()
+            .is_some_and(|sinks| sinks.foxglove.is_some())
+            || self.writer.is_some();
+        let sample = foxglove.then(|| RobotSample::of(sim));
+        self.record_row(sim.telemetry(), sample)
     }
 
-    /// Keeps one telemetry row in bounded memory, for the plots (and writes it to the CSV file);
-    /// once a second, flushes the logs to disk.
+    /// Keeps one telemetry row in bounded memory, for the plots (and writes it to the CSV file).
     pub fn row(&mut self, row: TelemetryRow) -> Result<(), OutputError> {
-        if let Some(csv) = &mut self.csv {
-            csv.write(&row)?;
+        self.record_row(row, None)
+    }
+
+    fn record_row(
+        &mut self,
+        row: TelemetryRow,
+        sample: Option<RobotSample>,
+    ) -> Result<(), OutputError> {
+        if let Some(writer) = self.writer()? {
+            writer.push(Record::Cycle {
+                row: row.clone(),
+                sample,
+            })?;
         }
         if !self.discard_rows {
             self.rows.push(row);
         }
-        if self
-            .last_flush
-            .is_some_and(|at| at.elapsed() >= FLUSH_EVERY)
-        {
-            self.flush()?;
-        }
-        Ok(())
-    }
-
-    /// Puts everything logged so far on disk.
-    pub fn flush(&mut self) -> Result<(), OutputError> {
-        if let Some(csv) = &mut self.csv {
-            csv.flush()?;
-        }
-        if let Some((path, writer)) = &mut self.candump {
-            writer.flush().map_err(|source| OutputError::Io {
-                path: path.clone(),
-                source,
-            })?;
-        }
-        if let Some(foxglove) = &mut self.foxglove {
-            foxglove.flush()?;
-        }
-        self.last_flush = Some(Instant::now());
         Ok(())
     }
 
@@ -171,18 +151,13 @@ impl Recorder {
         self.frames
     }
 
-    /// Flushes the logs and returns the rows.
+    /// Completes the logs and returns the rows.
     pub fn finish(self) -> Result<Vec<TelemetryRow>, OutputError> {
-        if let Some(csv) = self.csv {
-            csv.finish()?;
+        if let Some(writer) = self.writer {
+            writer.finish()?;
         }
-        if let Some((path, writer)) = self.candump {
-            writer
-                .finish()
-                .map_err(|source| OutputError::Io { path, source })?;
-        }
-        if let Some(foxglove) = self.foxglove {
-            foxglove.finish()?;
+        if let Some(sinks) = self.sinks {
+            sinks.finish()?;
         }
         Ok(self.rows.into_vec())
     }

@@ -106,6 +106,32 @@ pub const TF_HZ: f64 = 50.0;
 /// The joint states' rate, Hz: half the control rate of 250 Hz, for plots.
 pub const JOINTS_HZ: f64 = 125.0;
 
+/// The robot's state at one step, copied off the simulator for the log writer's thread.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RobotSample {
+    /// Simulated time, s.
+    pub time_s: f64,
+    /// MuJoCo's `qpos`.
+    pub qpos: Vec<f64>,
+    /// MuJoCo's `qvel`.
+    pub qvel: Vec<f64>,
+    /// MuJoCo's `qfrc_actuator`.
+    pub qfrc_actuator: Vec<f64>,
+}
+
+impl RobotSample {
+    /// The state of `sim` now.
+    pub fn of(sim: &Simulator) -> Self {
+        let data = sim.physics().data();
+        Self {
+            time_s: sim.time_s(),
+            qpos: data.qpos().to_vec(),
+            qvel: data.qvel().to_vec(),
+            qfrc_actuator: data.qfrc_actuator().to_vec(),
+        }
+    }
+}
+
 /// When a decimated topic is next due, s.
 #[derive(Debug, Clone, Copy, Default)]
 struct Due {
@@ -266,16 +292,15 @@ impl FoxgloveLog {
         }
     }
 
-    /// Logs the robot's pose and joints at the simulator's present step.
-    pub fn cycle(&mut self, sim: &Simulator) {
+    /// Logs the robot's pose and joints at the step `sample` was taken.
+    pub fn cycle(&mut self, sample: &RobotSample) {
         self.log_can();
-        let time_s = sim.time_s();
-        let data = sim.physics().data();
+        let time_s = sample.time_s;
         if self.tf_due.now(time_s, TF_HZ) {
-            self.transforms(time_s, data.qpos());
+            self.transforms(time_s, &sample.qpos);
         }
         if self.joints_due.now(time_s, JOINTS_HZ) {
-            self.joint_states(time_s, sim);
+            self.joint_states(sample);
         }
         if self
             .described_s
@@ -316,9 +341,9 @@ impl FoxgloveLog {
             .log_with_time(&FrameTransforms { transforms }, nanos(time_s));
     }
 
-    fn joint_states(&self, time_s: f64, sim: &Simulator) {
-        let data = sim.physics().data();
-        let (qpos, qvel, effort) = (data.qpos(), data.qvel(), data.qfrc_actuator());
+    fn joint_states(&self, sample: &RobotSample) {
+        let time_s = sample.time_s;
+        let (qpos, qvel, effort) = (&sample.qpos, &sample.qvel, &sample.qfrc_actuator);
         let hinges: Vec<_> = self.tree.hinges().collect();
         let value = |values: &[f64], at: usize| values.get(at).copied().unwrap_or(0.0);
         let joints = messages::JointState {
