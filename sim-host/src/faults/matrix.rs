@@ -110,68 +110,182 @@ pub(super) fn clean_until(model: &Path, motion: Motion, until_s: f64) -> Result<
     Ok(rig)
 }
 
-/// Runs every cell on `model`.
+/// One cell of the matrix, to run on its own MuJoCo instance.
+#[derive(Debug, Clone)]
+enum Cell {
+    /// `motion` under `plan` keeps going (compared with its clean run).
+    KeepsGoing(Motion, String, Faults),
+    /// `motion` with the link lost from 2 s, for a burst of this many cycles or for good (0).
+    SafeStopOnLoss(Motion, u32),
+    /// The trot with flipped bits or replayed frames.
+    FlipsAndReplays(&'static str, Faults),
+    Flood,
+    FeedbackSilent,
+    FirmwareKilled,
+    SimulatorRestarted,
+    EStop(NodeId),
+    ReleaseReplayed,
+    ForgedCommands,
+    RestartInterlock,
+}
+
+/// Runs every cell on `model`, on every core (each cell its own MuJoCo instance, as the
+/// campaign's runs; the table comes out in the same order whatever the cores): the clean runs
+/// first, which the loss and delay cells are compared with.
 pub fn run(model: &Path) -> Result<Vec<CellResult>, SessionError> {
-    let clean = Faults::default();
-    let mut cells = Vec::new();
-    for motion in [Motion::Trot, Motion::Drive] {
-        let baseline = run_motion(model, motion, &clean, &clean)?;
-        let base_m = forward_m(baseline.records());
-        cells.push(CellResult {
-            name: format!("{}, clean bus", motion.name()),
-            fault: "none".into(),
-            expected: "reference run",
-            measured: format!(
-                "{base_m:.2} m in {RUN_S} s, max tilt {:.1}°",
-                max_tilt_deg(baseline.records())
-            ),
-            pass: !fell(baseline.records()) && base_m > 0.5,
-        });
-        for p in [0.01, 0.05] {
-            let plan = both(
-                FaultPlan {
-                    drop: p,
-                    ..FaultPlan::default()
-                },
-                2,
-            );
-            let what = format!("loss {:.0}%", p * 100.0);
-            cells.push(keeps_going(model, motion, &what, &plan, base_m)?);
-        }
-        cells.push(safe_stop_on_loss(model, motion, 0)?);
-        // 5 cycles are 20 ms at 250 Hz.
-        cells.push(safe_stop_on_loss(model, motion, 5)?);
-        for delay in 1..=3 {
-            let plan = both(
-                FaultPlan {
-                    delay_cycles: delay,
-                    ..FaultPlan::default()
-                },
-                1,
-            );
-            let what = format!("delay {delay} cycles each way");
-            cells.push(keeps_going(model, motion, &what, &plan, base_m)?);
+    let jobs = crate::campaign::pool::default_jobs();
+    let motions = [Motion::Trot, Motion::Drive];
+    let (baselines, _) = crate::campaign::pool::run_all(
+        &motions,
+        jobs,
+        false,
+        |&motion| baseline(model, motion),
+        Result::is_err,
+    );
+    let mut base_cells = Vec::new();
+    let mut base_m = [0.0; 2];
+    for (baseline, base) in baselines.into_iter().zip(&mut base_m) {
+        let (cell, forward_m) = baseline?;
+        *base = forward_m;
+        base_cells.push(cell);
+    }
+    let per_motion: Vec<Vec<Cell>> = motions.iter().map(|&m| motion_cells(m)).collect();
+    let all: Vec<Cell> = per_motion
+        .iter()
+        .flatten()
+        .cloned()
+        .chain(matrix_cells())
+        .collect();
+    let (results, _) = crate::campaign::pool::run_all(
+        &all,
+        jobs,
+        true,
+        |cell| run_cell(model, cell, &motions, &base_m),
+        Result::is_err,
+    );
+    // The table's order: each clean run with its cells, then the rest.
+    let mut results = results.into_iter();
+    let mut cells = Vec::with_capacity(all.len() + base_cells.len());
+    for (base, motion_cells) in base_cells.into_iter().zip(&per_motion) {
+        cells.push(base);
+        for result in results.by_ref().take(motion_cells.len()) {
+            cells.push(result?);
         }
     }
+    for result in results {
+        cells.push(result?);
+    }
+    Ok(cells)
+}
+
+/// `motion` on a clean bus: its cell, and how far it went, m.
+fn baseline(model: &Path, motion: Motion) -> Result<(CellResult, f64), SessionError> {
+    let clean = Faults::default();
+    let baseline = run_motion(model, motion, &clean, &clean)?;
+    let base_m = forward_m(baseline.records());
+    let cell = CellResult {
+        name: format!("{}, clean bus", motion.name()),
+        fault: "none".into(),
+        expected: "reference run",
+        measured: format!(
+            "{base_m:.2} m in {RUN_S} s, max tilt {:.1}°",
+            max_tilt_deg(baseline.records())
+        ),
+        pass: !fell(baseline.records()) && base_m > 0.5,
+    };
+    Ok((cell, base_m))
+}
+
+/// A motion's loss and delay cells, in the table's order.
+fn motion_cells(motion: Motion) -> Vec<Cell> {
+    let mut cells = Vec::new();
+    for p in [0.01, 0.05] {
+        let plan = both(
+            FaultPlan {
+                drop: p,
+                ..FaultPlan::default()
+            },
+            2,
+        );
+        cells.push(Cell::KeepsGoing(
+            motion,
+            format!("loss {:.0}%", p * 100.0),
+            plan,
+        ));
+    }
+    cells.push(Cell::SafeStopOnLoss(motion, 0));
+    // 5 cycles are 20 ms at 250 Hz.
+    cells.push(Cell::SafeStopOnLoss(motion, 5));
+    for delay in 1..=3 {
+        let plan = both(
+            FaultPlan {
+                delay_cycles: delay,
+                ..FaultPlan::default()
+            },
+            1,
+        );
+        cells.push(Cell::KeepsGoing(
+            motion,
+            format!("delay {delay} cycles each way"),
+            plan,
+        ));
+    }
+    cells
+}
+
+/// The cells that need no clean run, in the table's order.
+fn matrix_cells() -> Vec<Cell> {
     let flips = FaultPlan {
         flip: 0.02,
         ..FaultPlan::default()
     };
-    cells.push(flips_and_replays(model, "flip", both(flips, 5))?);
     let replays = FaultPlan {
         replay: 0.02,
         ..FaultPlan::default()
     };
-    cells.push(flips_and_replays(model, "replay", both(replays, 6))?);
-    cells.push(flood(model)?);
-    cells.push(feedback_silent(model)?);
-    cells.push(firmware_killed(model)?);
-    cells.push(simulator_restarted(model)?);
-    cells.extend(estop_cells(model)?);
-    cells.push(release_replayed(model)?);
-    cells.push(forged_commands(model)?);
-    cells.push(restart_interlock(model)?);
-    Ok(cells)
+    vec![
+        Cell::FlipsAndReplays("flip", both(flips, 5)),
+        Cell::FlipsAndReplays("replay", both(replays, 6)),
+        Cell::Flood,
+        Cell::FeedbackSilent,
+        Cell::FirmwareKilled,
+        Cell::SimulatorRestarted,
+        Cell::EStop(NodeId::Teleop),
+        Cell::EStop(NodeId::Tool),
+        Cell::ReleaseReplayed,
+        Cell::ForgedCommands,
+        Cell::RestartInterlock,
+    ]
+}
+
+/// Runs `cell`; a motion's cells compare with its clean run's distance (`base_m`, in the order
+/// of `motions`).
+fn run_cell(
+    model: &Path,
+    cell: &Cell,
+    motions: &[Motion],
+    base_m: &[f64],
+) -> Result<CellResult, SessionError> {
+    match cell {
+        Cell::KeepsGoing(motion, what, plan) => {
+            let base = motions
+                .iter()
+                .zip(base_m)
+                .find(|(m, _)| *m == motion)
+                .map_or(0.0, |(_, b)| *b);
+            keeps_going(model, *motion, what, plan, base)
+        }
+        Cell::SafeStopOnLoss(motion, burst) => safe_stop_on_loss(model, *motion, *burst),
+        Cell::FlipsAndReplays(what, plan) => flips_and_replays(model, what, plan.clone()),
+        Cell::Flood => flood(model),
+        Cell::FeedbackSilent => feedback_silent(model),
+        Cell::FirmwareKilled => firmware_killed(model),
+        Cell::SimulatorRestarted => simulator_restarted(model),
+        Cell::EStop(from) => estop(model, *from),
+        Cell::ReleaseReplayed => release_replayed(model),
+        Cell::ForgedCommands => forged_commands(model),
+        Cell::RestartInterlock => restart_interlock(model),
+    }
 }
 
 /// The matrix's E-stop cells alone (from the teleop, and from `cansend`).
