@@ -19,28 +19,26 @@
 //! recover the chunks of a file without a footer).
 
 pub mod bodies;
+mod channels;
 pub mod messages;
 pub mod urdf;
 
 use std::fs::File;
 use std::io::BufWriter;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use foxglove::messages::log::Level as LogLevel;
 pub use foxglove::messages::CompressedImage;
 use foxglove::messages::{FrameTransform, FrameTransforms, Log, Quaternion, Timestamp, Vector3};
-use foxglove::{
-    Channel, Context, McapCompression, McapWriteOptions, McapWriterHandle, PartialMetadata,
-    RawChannel, Schema, WebSocketServerHandle,
-};
+use foxglove::{Channel, Context, McapWriterHandle, WebSocketServerHandle};
 use protocol::signal::WireField;
 use protocol::{decode_frame, AnyMessage, ControllerMode, FaultFlags, Frame};
-use serde_json::json;
 
 use crate::output::output_error::OutputError;
 use crate::session::simulator::Simulator;
 use bodies::{RobotTree, WORLD_FRAME};
+use channels::{open_mcap, Channels};
 
 /// The body the robot hangs from (its free joint).
 pub const ROOT_BODY: &str = "torso";
@@ -64,8 +62,8 @@ pub struct FoxgloveLog {
     urdf: String,
     channels: Channels,
     last_status: Option<(ControllerMode, FaultFlags)>,
-    /// When the description was last logged, s (repeated so that a late viewer gets it).
-    described_s: Option<f64>,
+    /// When the description is logged next (repeated so that a late viewer gets it).
+    description_due: Due,
     camera: Option<Arc<Channel<CompressedImage>>>,
     tf_due: Due,
     joints_due: Due,
@@ -85,19 +83,8 @@ impl std::fmt::Debug for FoxgloveLog {
     }
 }
 
-struct Channels {
-    tf: Channel<FrameTransforms>,
-    log: Channel<Log>,
-    joints: Channel<messages::JointState>,
-    imu: Channel<messages::Imu>,
-    wheels: Channel<messages::WheelFeedback>,
-    status: Channel<messages::ControllerStatus>,
-    can: Channel<messages::CanFrames>,
-    description: Arc<RawChannel>,
-}
-
-/// The robot description is logged again this often, s (repeated so that a late viewer gets it).
-const DESCRIBE_EVERY_S: f64 = 1.0;
+/// The robot description's rate, Hz (repeated so that a late viewer gets it).
+const DESCRIPTION_HZ: f64 = 1.0;
 
 /// The transforms' rate, Hz: smooth in a 3D view, and a fifth of the data the control rate's
 /// would be (23 transforms a message are most of the file).
@@ -178,7 +165,7 @@ impl FoxgloveLog {
             ),
             None => None,
         };
-        let channels = Channels::open(&context)?;
+        let channels = Channels::open(&context, &urdf)?;
         Ok(Some(Self {
             context,
             mcap,
@@ -187,7 +174,7 @@ impl FoxgloveLog {
             urdf,
             channels,
             last_status: None,
-            described_s: None,
+            description_due: Due::default(),
             camera: None,
             tf_due: Due::default(),
             joints_due: Due::default(),
@@ -302,16 +289,8 @@ impl FoxgloveLog {
         if self.joints_due.now(time_s, JOINTS_HZ) {
             self.joint_states(sample);
         }
-        if self
-            .described_s
-            .is_none_or(|at| time_s - at >= DESCRIBE_EVERY_S)
-        {
-            self.described_s = Some(time_s);
-            log_json(
-                &self.channels.description,
-                &json!({ "data": self.urdf }),
-                meta(time_s),
-            );
+        if self.description_due.now(time_s, DESCRIPTION_HZ) {
+            self.channels.describe(time_s);
         }
     }
 
@@ -381,78 +360,6 @@ impl FoxgloveLog {
     }
 }
 
-impl Channels {
-    fn open(context: &Arc<Context>) -> Result<Self, OutputError> {
-        let json = |topic: &str, schema: &str, properties: serde_json::Value| {
-            let schema_json = json!({
-                "type": "object",
-                "title": schema,
-                "properties": properties,
-            });
-            context
-                .channel_builder(topic)
-                .message_encoding("json")
-                .schema(Schema::new(
-                    schema,
-                    "jsonschema",
-                    schema_json.to_string().into_bytes(),
-                ))
-                .build_raw()
-                .map_err(|source| OutputError::Channel {
-                    topic: topic.to_owned(),
-                    source,
-                })
-        };
-        Ok(Self {
-            tf: context.channel_builder("/tf").build(),
-            log: context.channel_builder("/controller/log").build(),
-            joints: context.channel_builder("/joint_states").build(),
-            imu: context.channel_builder("/imu").build(),
-            wheels: context.channel_builder("/wheels").build(),
-            status: context.channel_builder("/controller/status").build(),
-            can: context.channel_builder("/can").build(),
-            description: json(
-                "/robot_description",
-                "std_msgs/String",
-                json!({"data": {"type": "string"}}),
-            )?,
-        })
-    }
-}
-
-/// The MCAP writer on `context`, lz4-chunked, with the URDF attached.
-fn open_mcap(
-    context: &Arc<Context>,
-    path: &Path,
-    urdf: &str,
-) -> Result<McapWriterHandle<BufWriter<File>>, OutputError> {
-    let failed = |source| OutputError::Mcap {
-        path: path.to_owned(),
-        source,
-    };
-    let options = McapWriteOptions::default().compression(Some(McapCompression::Lz4));
-    // Replaced, as the run's other logs are: a second run into the same folder is the usual
-    // case (the demo's `out/`).
-    let file = File::create(path).map_err(|source| OutputError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
-    let writer = context
-        .mcap_writer_with_options(options)
-        .create(BufWriter::new(file))
-        .map_err(failed)?;
-    writer
-        .attach(&foxglove::McapAttachment {
-            log_time: 0,
-            create_time: 0,
-            name: "robot.urdf".into(),
-            media_type: "application/xml".into(),
-            data: urdf.as_bytes().into(),
-        })
-        .map_err(failed)?;
-    Ok(writer)
-}
-
 fn transform(
     timestamp: Option<Timestamp>,
     parent: &str,
@@ -475,19 +382,9 @@ fn transform(
     }
 }
 
-fn log_json(channel: &RawChannel, message: &serde_json::Value, at: PartialMetadata) {
-    channel.log_with_meta(message.to_string().as_bytes(), at);
-}
-
 /// Simulation time `time_s` as a log time, ns.
 pub fn nanos(time_s: f64) -> u64 {
     (time_s.max(0.0) * 1e9).round() as u64
-}
-
-fn meta(time_s: f64) -> PartialMetadata {
-    PartialMetadata {
-        log_time: Some(nanos(time_s)),
-    }
 }
 
 /// The timestamp of simulation time `time_s`.
