@@ -31,6 +31,8 @@ pub struct Recorder {
     writer: Option<LogWriter>,
     frames: u64,
     discard_rows: bool,
+    /// Whether a Foxglove log wants the robot's state every cycle.
+    sampling: bool,
 }
 
 impl Recorder {
@@ -77,6 +79,7 @@ impl Recorder {
     /// Also logs to `foxglove` (an MCAP file, a live server). Before the first record only.
     pub fn set_foxglove(&mut self, foxglove: FoxgloveLog) {
         self.sinks_mut().foxglove = Some(foxglove);
+        self.sampling = true;
     }
 
     /// The Foxglove log, to add a channel to, before the first record.
@@ -109,12 +112,7 @@ impl Recorder {
     /// Records the simulator's present step: its telemetry row and, with a Foxglove log, the
     /// robot's state.
     pub fn cycle(&mut self, sim: &Simulator) -> Result<(), OutputError> {
-        let foxglove = self
-            .sinks
-            .as_ref()
-            .is_some_and(|sinks| sinks.foxglove.is_some())
-            || self.writer.is_some();
-        let sample = foxglove.then(|| RobotSample::of(sim));
+        let sample = self.sampling.then(|| RobotSample::of(sim));
         self.record_row(sim.telemetry(), sample)
     }
 
