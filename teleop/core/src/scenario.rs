@@ -129,6 +129,13 @@ pub fn parse_mode(text: &str) -> Option<TeleopMode> {
     }
 }
 
+/// The largest ground speed a step may ask for, m/s: the wire's (`protocol::GroundSpeed`); the
+/// controller takes less.
+const SPEED_LIMIT_M_S: f32 = 2.0;
+
+/// The largest yaw rate a step may ask for, rad/s: the wire's (`protocol::YawRate`).
+const YAW_RATE_LIMIT_RAD_S: f32 = 3.0;
+
 /// Whether `mode` follows a ground speed: `drive` and `walk`.
 pub const fn takes_speed(mode: TeleopMode) -> bool {
     matches!(mode, TeleopMode::Drive | TeleopMode::Walk)
@@ -185,7 +192,7 @@ pub fn parse_drive_step(text: &str) -> Result<PlanStep, String> {
         };
         match key.trim() {
             "speed" if takes_speed(mode) => {
-                step.speed_m_s = number(-2.0..=2.0, "m/s")?;
+                step.speed_m_s = number(-SPEED_LIMIT_M_S..=SPEED_LIMIT_M_S, "m/s")?;
             }
             "speed" => return Err(format!("`{part}`: only drive and walk take a speed")),
             "yaw"
@@ -197,7 +204,8 @@ pub fn parse_drive_step(text: &str) -> Result<PlanStep, String> {
                         | TeleopMode::Fold
                 ) =>
             {
-                step.yaw_rate_rad_s = number(-3.0..=3.0, "rad/s")?;
+                step.yaw_rate_rad_s =
+                    number(-YAW_RATE_LIMIT_RAD_S..=YAW_RATE_LIMIT_RAD_S, "rad/s")?;
             }
             "yaw" => return Err(format!("`{part}`: {} ignores a yaw rate", mode_name(mode))),
             other => return Err(format!("`{other}`: expected speed=M_S or yaw=RAD_S")),
@@ -350,11 +358,13 @@ impl Source<'_> {
                 format!("yaw_rate_rad_s: mode {name} ignores it; use W, S, L, K, drive or walk");
             return Err(self.value_error(v.span().start, message));
         }
-        let speed = self.in_range(&s.speed_m_s, -2.0..=2.0, 0.0, |v| {
-            format!("speed_m_s = {v}: the range is −2…+2 m/s")
+        let speed_limit = f64::from(SPEED_LIMIT_M_S);
+        let speed = self.in_range(&s.speed_m_s, -speed_limit..=speed_limit, 0.0, |v| {
+            format!("speed_m_s = {v}: the range is −{speed_limit}…+{speed_limit} m/s")
         })?;
-        let yaw = self.in_range(&s.yaw_rate_rad_s, -3.0..=3.0, 0.0, |v| {
-            format!("yaw_rate_rad_s = {v}: the range is −3…+3 rad/s")
+        let yaw_limit = f64::from(YAW_RATE_LIMIT_RAD_S);
+        let yaw = self.in_range(&s.yaw_rate_rad_s, -yaw_limit..=yaw_limit, 0.0, |v| {
+            format!("yaw_rate_rad_s = {v}: the range is −{yaw_limit}…+{yaw_limit} rad/s")
         })?;
         Ok((speed, yaw))
     }
