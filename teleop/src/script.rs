@@ -108,7 +108,9 @@ pub fn run(
             on_step(started);
             started += 1;
         }
-        teleop.frames(now_us)
+        teleop
+            .frames(now_us)
+            .map(|frames| frames.into_iter().collect())
     })
 }
 

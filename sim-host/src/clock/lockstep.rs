@@ -93,7 +93,10 @@ pub fn cycle(
     // Feedback first, then SYNC: a controller in another process computes the tick when
     // SYNC arrives, with this cycle's feedback already in hand.
     let mut outgoing = sim.frames_due()?;
-    outgoing.extend(sim.sync_frame()?);
+    if let Some(sync) = sim.sync_frame()? {
+        // SYNC has its slot in the schedule, which no node fills: there is room.
+        let _ = outgoing.push(sync);
+    }
     // In one call: a controller in another process wakes once for the cycle, not per frame.
     bus.send_all(&outgoing)?;
     for frame in &outgoing {

@@ -30,6 +30,11 @@ impl<T: Clone> Decimated<T> {
     /// Adds a sample.
     pub fn push(&mut self, sample: T) {
         if self.seen % self.stride == 0 {
+            if self.kept.capacity() == 0 {
+                // Once, whole: the series never grows past it, so a run allocates nothing more
+                // for it (pages are touched only as samples fill them).
+                self.kept.reserve_exact(Self::CAPACITY);
+            }
             self.kept.push(sample);
             self.latest = None;
             if self.kept.len() >= Self::CAPACITY {

@@ -1,9 +1,9 @@
 //! The run's log files written off the simulation's thread: the recorder hands its records over
 //! in batches (at most every [`HANDOFF_EVERY`] or [`BATCH`] records, never a hand-off per
 //! cycle), and a writer thread formats and writes them — the candump log, the telemetry CSV and
-//! the Foxglove MCAP — and flushes them every [`FLUSH_EVERY`]. Memory stays bounded: at most
-//! [`BATCHES`] batches are in flight, and the simulation waits for the writer rather than
-//! queueing without end. Emptied batches come back to be filled again.
+//! the Foxglove MCAP — and flushes them every [`FLUSH_EVERY`]. Memory stays bounded and is allocated once: [`BATCHES`] batches and the
+//! one being filled, which go round — the simulation waits for an emptied one rather than
+//! making another.
 //!
 //! A run killed outright leaves the files readable up to within a hand-off and a flush of the
 //! kill (under half a second); a writer that fails (a full disk) stops the run at its next
@@ -12,7 +12,7 @@
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::PathBuf;
-use std::sync::mpsc::{self, Receiver, RecvTimeoutError, SyncSender};
+use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
@@ -20,6 +20,7 @@ use host_can::candump::{CandumpWriter, LoggedFrame};
 use protocol::Frame;
 
 use crate::output::foxglove::{FoxgloveLog, RobotSample};
+use crate::output::handoff::{Handoff, Next};
 use crate::output::output_error::OutputError;
 use crate::output::telemetry::TelemetryRow;
 use crate::output::telemetry_csv::CsvWriter;
@@ -33,7 +34,8 @@ pub const HANDOFF_EVERY: Duration = Duration::from_millis(50);
 /// Records a batch holds before it is handed over (about 20 control cycles of frames).
 pub const BATCH: usize = 256;
 
-/// Batches in flight at most.
+/// Batches there are besides the one being filled: queued for the writer, being written, or
+/// spare.
 pub const BATCHES: usize = 4;
 
 /// One thing to log.
@@ -140,8 +142,7 @@ impl Sinks {
 /// The writer thread and the batch being filled.
 #[derive(Debug)]
 pub struct LogWriter {
-    to_writer: Option<SyncSender<Vec<Record>>>,
-    spares: Receiver<Vec<Record>>,
+    handoff: Arc<Handoff<Vec<Record>>>,
     thread: Option<JoinHandle<Result<(), OutputError>>>,
     batch: Vec<Record>,
     since: Instant,
@@ -150,18 +151,24 @@ pub struct LogWriter {
 impl LogWriter {
     /// Starts the writer thread on `sinks`.
     pub fn start(sinks: Sinks) -> Result<Self, OutputError> {
-        let (to_writer, from_sim) = mpsc::sync_channel(BATCHES);
-        let (to_sim, spares) = mpsc::channel();
+        // Every batch there will be, made now: the simulation's thread never allocates one.
+        let spares = (0..BATCHES).map(|_| Vec::with_capacity(BATCH)).collect();
+        let handoff = Arc::new(Handoff::new(spares));
+        let writer_side = Arc::clone(&handoff);
         let thread = std::thread::Builder::new()
             .name("log-writer".into())
-            .spawn(move || write_all(sinks, &from_sim, &to_sim))
+            .spawn(move || {
+                let stopped = Stopped(&writer_side);
+                let result = write_all(sinks, stopped.0);
+                drop(stopped);
+                result
+            })
             .map_err(|source| OutputError::Io {
                 path: PathBuf::from("<log writer thread>"),
                 source,
             })?;
         Ok(Self {
-            to_writer: Some(to_writer),
-            spares,
+            handoff,
             thread: Some(thread),
             batch: Vec::with_capacity(BATCH),
             since: Instant::now(),
@@ -179,20 +186,20 @@ impl LogWriter {
 
     fn hand_off(&mut self) -> Result<(), OutputError> {
         self.since = Instant::now();
-        if self.batch.is_empty() {
+        if self.batch.is_empty() || self.thread.is_none() {
             return Ok(());
         }
-        let next = self
-            .spares
-            .try_recv()
-            .unwrap_or_else(|_| Vec::with_capacity(BATCH));
-        let full = std::mem::replace(&mut self.batch, next);
-        let sent = self.to_writer.as_ref().map(|tx| tx.send(full));
-        if matches!(sent, Some(Err(_))) {
+        // An emptied batch comes back as soon as the writer has written one: waiting for it is
+        // the bound on memory.
+        let full = std::mem::take(&mut self.batch);
+        match self.handoff.exchange(full) {
+            Ok(empty) => {
+                self.batch = empty;
+                Ok(())
+            }
             // The writer stopped: its error says why.
-            return self.join();
+            Err(_) => self.join(),
         }
-        Ok(())
     }
 
     /// Hands over the rest, waits for the writer to complete every file, and reports its
@@ -203,7 +210,7 @@ impl LogWriter {
     }
 
     fn join(&mut self) -> Result<(), OutputError> {
-        drop(self.to_writer.take());
+        self.handoff.hang_up();
         match self.thread.take().map(JoinHandle::join) {
             Some(Ok(result)) => result,
             Some(Err(_)) => Err(OutputError::Io {
@@ -224,26 +231,30 @@ impl Drop for LogWriter {
     }
 }
 
+/// Tells the recorder the writer has stopped, however it stops (a panic included).
+struct Stopped<'a>(&'a Handoff<Vec<Record>>);
+
+impl Drop for Stopped<'_> {
+    fn drop(&mut self) {
+        self.0.writer_stopped();
+    }
+}
+
 /// The writer thread: every batch into the files, a flush every [`FLUSH_EVERY`], the files
 /// completed when the recorder hangs up.
-fn write_all(
-    mut sinks: Sinks,
-    batches: &Receiver<Vec<Record>>,
-    spares: &mpsc::Sender<Vec<Record>>,
-) -> Result<(), OutputError> {
+fn write_all(mut sinks: Sinks, handoff: &Handoff<Vec<Record>>) -> Result<(), OutputError> {
     let mut flushed = Instant::now();
     loop {
-        match batches.recv_timeout(FLUSH_EVERY) {
-            Ok(mut batch) => {
+        match handoff.next(FLUSH_EVERY) {
+            Next::Full(mut batch) => {
                 for record in &batch {
                     sinks.record(record)?;
                 }
                 batch.clear();
-                // The recorder may be gone at the end: the batch is then simply dropped.
-                let _ = spares.send(batch);
+                handoff.give_back(batch);
             }
-            Err(RecvTimeoutError::Timeout) => {}
-            Err(RecvTimeoutError::Disconnected) => return sinks.finish(),
+            Next::Timeout => {}
+            Next::Finished => return sinks.finish(),
         }
         if flushed.elapsed() >= FLUSH_EVERY {
             sinks.flush()?;

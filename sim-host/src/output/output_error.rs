@@ -49,6 +49,14 @@ pub enum OutputError {
         #[source]
         source: foxglove::FoxgloveError,
     },
+    /// The model has more coordinates than the Foxglove log's samples hold.
+    #[error("the model has {coordinates} position coordinates; the Foxglove log holds at most {max} (a scene with fewer free bodies, or run without an output folder)")]
+    TooManyCoordinates {
+        /// The model's `nq`.
+        coordinates: usize,
+        /// What a sample holds.
+        max: usize,
+    },
     /// The live Foxglove server could not start.
     #[error("cannot serve Foxglove on 127.0.0.1:{port}: {source} (is the port taken? give another with --foxglove-port, or 0 for any)")]
     LiveServer {

@@ -17,6 +17,10 @@ use crate::robot::physics::Physics;
 use crate::robot::plant::Plant;
 use crate::robot::wheel_drive::WheelDrive;
 
+/// The frames the nodes send in one cycle: at most one per slot of the schedule, held without
+/// the heap (the simulation's thread allocates nothing per cycle).
+pub type FramesDue = heapless::Vec<Frame, { SCHEDULE.len() }>;
+
 /// The robot's CAN nodes.
 #[derive(Debug, Clone)]
 pub struct Hardware {
@@ -123,8 +127,8 @@ impl Hardware {
         now_us: u64,
         cycle: u32,
         physics: &Physics,
-    ) -> Result<Vec<Frame>, EncodeError> {
-        let mut frames = Vec::with_capacity(8);
+    ) -> Result<FramesDue, EncodeError> {
+        let mut frames = FramesDue::new();
         for slot in SCHEDULE
             .iter()
             .filter(|s| s.sends_in(cycle, self.control_hz))
@@ -153,8 +157,11 @@ impl Hardware {
                 }
                 _ => continue,
             };
-            // A node that has not heard the controller's announcement yet sends nothing.
-            frames.extend(sealed);
+            // A node that has not heard the controller's announcement yet sends nothing. The
+            // schedule has a slot per frame, so there is always room.
+            if let Some(frame) = sealed {
+                let _ = frames.push(frame);
+            }
         }
         Ok(frames)
     }

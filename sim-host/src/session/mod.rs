@@ -5,12 +5,13 @@
 //! - [`simulator`]: the model and its emulated hardware, one control cycle at a time;
 //! - [`inproc_controller`]: the firmware's control core on the in-process bus;
 //! - [`run`]: one run (bus, clock, observers, outputs), with [`nodes`], [`segments`] and
-//!   [`watch`] as its parts; [`run_stats`]: its counters.
+//!   [`watch`] as its parts; [`run_stats`]: its counters; [`resident`]: its memory.
 
 pub mod config;
 pub mod error;
 pub mod inproc_controller;
 pub(crate) mod nodes;
+pub mod resident;
 pub mod run;
 pub mod run_stats;
 pub(crate) mod segments;

@@ -24,6 +24,7 @@ use crate::session::config::{BusChoice, Clock, SessionConfig};
 use crate::session::error::SessionError;
 use crate::session::inproc_controller::InprocController;
 use crate::session::nodes::{FirmwareCounters, Nodes, Peers};
+use crate::session::resident::Resident;
 use crate::session::run_stats::{RunError, RunStats};
 use crate::session::segments::Segments;
 use crate::session::simulator::{Simulator, StartPose};
@@ -50,6 +51,8 @@ pub struct SessionReport {
     pub interrupted: bool,
     /// Figures per segment.
     pub segments: Vec<SegmentSummary>,
+    /// The process's resident memory, each simulated minute.
+    pub resident: Resident,
     /// What [`SessionConfig::faults`] did: to the frames the simulator sent, and to those it
     /// received.
     pub fault_stats: [FaultStats; 2],
@@ -84,6 +87,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         watch_error: None,
         interrupted: false,
         counters: Rc::clone(&counters),
+        resident: Resident::default(),
     };
     let mut nodes = Nodes::join(config)?;
     let mut peers = Peers {
@@ -129,6 +133,7 @@ pub fn run(config: &SessionConfig) -> Result<SessionReport, SessionError> {
         interrupted: observer.interrupted,
         segments,
         fault_stats,
+        resident: observer.resident,
     })
 }
 
@@ -217,6 +222,7 @@ struct Observer<'a> {
     watch_error: Option<SessionError>,
     interrupted: bool,
     counters: FirmwareCounters,
+    resident: Resident,
 }
 
 impl Observer<'_> {
@@ -232,6 +238,8 @@ impl Observer<'_> {
             missed_cycles: stats.missed_cycles,
         };
         self.segments.observe(s, counters);
+        self.resident
+            .cycle(s.cycle(), self.config.control_hz, s.time_s());
         if u64::from(s.cycle()) % 25 == 0 {
             self.progress.set_position(u64::from(s.cycle()));
         }

@@ -9,7 +9,7 @@ use protocol::{AnyMessage, EncodeError, Frame, Joints, Key, MessageId, Sync, Tic
 use crate::robot::link::NodeLink;
 
 use crate::output::telemetry::TelemetryRow;
-use crate::robot::hardware::Hardware;
+use crate::robot::hardware::{FramesDue, Hardware};
 use crate::robot::model::ModelError;
 use crate::robot::physics::Physics;
 use crate::robot::plant::Plant;
@@ -160,7 +160,7 @@ impl Simulator {
     }
 
     /// The frames the nodes send at the start of this cycle (feedback, IMU, status).
-    pub fn frames_due(&mut self) -> Result<Vec<Frame>, EncodeError> {
+    pub fn frames_due(&mut self) -> Result<FramesDue, EncodeError> {
         self.hardware
             .frames_due(self.now_us, self.cycle, &self.physics)
     }

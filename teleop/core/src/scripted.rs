@@ -69,6 +69,10 @@ impl PlanStep {
     }
 }
 
+/// The frames the operator sends at one moment: the command and the heartbeat at most, held
+/// without the heap (a lockstep cycle allocates nothing).
+pub type TeleopFrames = heapless::Vec<Frame, 2>;
+
 /// The scripted operator.
 #[derive(Debug, Clone)]
 pub struct ScriptedTeleop {
@@ -122,11 +126,13 @@ impl ScriptedTeleop {
 
     /// The frames to send at `now_us`: the command in its 50 Hz slots, the heartbeat in slots
     /// half a period later (as the interactive operator sends them).
-    pub fn frames(&mut self, now_us: u64) -> Result<Vec<Frame>, EncodeError> {
-        let mut frames = Vec::with_capacity(2);
+    pub fn frames(&mut self, now_us: u64) -> Result<TeleopFrames, EncodeError> {
+        let mut frames = TeleopFrames::new();
         if now_us >= self.next_send_us {
             self.next_send_us = now_us - now_us % PERIOD_US + PERIOD_US;
-            frames.extend(self.command(now_us)?);
+            if let Some(command) = self.command(now_us)? {
+                let _ = frames.push(command);
+            }
         }
         if now_us >= self.next_heartbeat_us {
             // The next time after now at the heartbeat's phase of the period.
@@ -136,7 +142,9 @@ impl ScriptedTeleop {
             let heartbeat = AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
                 uptime: Millis::from_raw(uptime_ms).unwrap_or(Millis::saturating_from_si(0.0)),
             });
-            frames.extend(self.link.seal(&heartbeat)?);
+            if let Some(heartbeat) = self.link.seal(&heartbeat)? {
+                let _ = frames.push(heartbeat);
+            }
         }
         Ok(frames)
     }

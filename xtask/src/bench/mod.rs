@@ -1,7 +1,7 @@
 //! `cargo xtask bench`: the criterion benchmarks, then a table of their medians, printed and
 //! written into docs/measurements.md between the `bench:begin` and `bench:end` markers; then
-//! `sim-host run` beside the report's loop in Python ([`whole_run`]), between `bench-run:begin`
-//! and `bench-run:end`.
+//! `sim-host run`, bare and with every output, beside the report's program in Python, and an
+//! hour's run for its memory ([`whole_run`]), between `bench-run:begin` and `bench-run:end`.
 //!
 //! Timings on shared machines are noisy: compare figures within one run (the ratio of the
 //! typed step to the full CAN node, of the closed loop to raw MuJoCo), not against a fixed
@@ -87,12 +87,12 @@ pub fn run_task(args: &[String]) -> Result<(), String> {
     };
     let table = markdown_table(&rows, summary.as_deref());
     crate::faults::write_section(&root().join(PAGE), BEGIN, END, &table, false, "bench")?;
-    let raw_steps_per_s = match medians[..] {
-        [.., raw, _] => 1e9 / raw,
+    let (raw_steps_per_s, closed_steps_per_s) = match medians[..] {
+        [.., raw, closed] => (1e9 / raw, 1e9 / closed),
         _ => return Err("no MuJoCo step median".into()),
     };
     let measured = whole_run::measure()?;
-    let comparison = whole_run::markdown(&measured, raw_steps_per_s);
+    let comparison = whole_run::markdown(&measured, raw_steps_per_s, closed_steps_per_s);
     println!("\n{comparison}");
     crate::faults::write_section(
         &root().join(PAGE),

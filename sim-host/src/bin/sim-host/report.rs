@@ -50,6 +50,9 @@ pub(crate) fn print(
         println!("  on feedback    {tx:?}");
         println!("  on commands    {rx:?}");
     }
+    if let Some(resident) = report.resident.describe() {
+        println!("memory           resident {resident}");
+    }
     if let Some(row) = last {
         println!(
             "torso at end     x {:.3} m, y {:.3} m, z {:.3} m, roll {:.1}°, pitch {:.1}°, yaw {:.1}°",

@@ -177,6 +177,10 @@ pub(crate) struct RunArgs {
     /// Skip the PNG plots.
     #[arg(long)]
     pub(crate) no_plots: bool,
+    /// Keep nothing on disk: no logs, no plots, no MCAP. A bare run, to time the loop against
+    /// one with every output, or to soak for hours.
+    #[arg(long, conflicts_with_all = ["out", "scenario", "scene", "render_every"])]
+    pub(crate) no_out: bool,
     /// No progress bar (for logs and scripts).
     #[arg(long)]
     pub(crate) no_progress: bool,
@@ -378,7 +382,7 @@ fn session_config(
         teleop_plan,
         attach: None,
         faults: args.faults.clone(),
-        out_dir: Some(args.out.clone()),
+        out_dir: (!args.no_out).then(|| args.out.clone()),
         plots: !args.no_plots,
         progress: !args.no_progress,
         frames: args.render_every.map(|every_cycles| FrameSettings {

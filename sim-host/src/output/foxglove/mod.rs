@@ -93,28 +93,38 @@ pub const TF_HZ: f64 = 50.0;
 /// The joint states' rate, Hz: half the control rate of 250 Hz, for plots.
 pub const JOINTS_HZ: f64 = 125.0;
 
-/// The robot's state at one step, copied off the simulator for the log writer's thread.
+/// Coordinates a [`RobotSample`] holds at most, per vector: the robot's 25 positions and 24
+/// velocities with room for a scene's free bodies.
+pub const MAX_COORDINATES: usize = 64;
+
+/// A vector of MuJoCo's coordinates, held without the heap.
+pub type Coordinates = heapless::Vec<f64, MAX_COORDINATES>;
+
+/// The robot's state at one step, copied off the simulator for the log writer's thread without
+/// an allocation (the simulation's thread allocates nothing per cycle).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RobotSample {
     /// Simulated time, s.
     pub time_s: f64,
     /// MuJoCo's `qpos`.
-    pub qpos: Vec<f64>,
+    pub qpos: Coordinates,
     /// MuJoCo's `qvel`.
-    pub qvel: Vec<f64>,
+    pub qvel: Coordinates,
     /// MuJoCo's `qfrc_actuator`.
-    pub qfrc_actuator: Vec<f64>,
+    pub qfrc_actuator: Coordinates,
 }
 
 impl RobotSample {
-    /// The state of `sim` now.
+    /// The state of `sim` now. [`FoxgloveLog::open`] refuses a model with more coordinates than
+    /// a sample holds, so none is cut short.
     pub fn of(sim: &Simulator) -> Self {
         let data = sim.physics().data();
+        let copy = |values: &[f64]| values.iter().copied().take(MAX_COORDINATES).collect();
         Self {
             time_s: sim.time_s(),
-            qpos: data.qpos().to_vec(),
-            qvel: data.qvel().to_vec(),
-            qfrc_actuator: data.qfrc_actuator().to_vec(),
+            qpos: copy(data.qpos()),
+            qvel: copy(data.qvel()),
+            qfrc_actuator: copy(data.qfrc_actuator()),
         }
     }
 }
@@ -146,6 +156,13 @@ impl FoxgloveLog {
             return Ok(None);
         }
         let model = sim.physics().model();
+        let coordinates = sim.physics().data().qpos().len();
+        if coordinates > MAX_COORDINATES {
+            return Err(OutputError::TooManyCoordinates {
+                coordinates,
+                max: MAX_COORDINATES,
+            });
+        }
         let tree =
             RobotTree::of(model, ROOT_BODY).ok_or(OutputError::NoRootBody { body: ROOT_BODY })?;
         let urdf = urdf::urdf(model, &tree, "hybrid_robot");
