@@ -13,6 +13,8 @@ use crate::bus::{Bus, BusError};
 #[derive(Debug, Default)]
 struct Shared {
     queues: Vec<VecDeque<Frame>>,
+    /// Endpoints waiting in `recv`: a send wakes them, and costs no wake-up call without.
+    waiting: usize,
 }
 
 /// The bus; [`InprocBus::endpoint`] attaches a node.
@@ -63,16 +65,30 @@ fn lock(mutex: &Mutex<Shared>) -> MutexGuard<'_, Shared> {
         .unwrap_or_else(|poisoned| poisoned.into_inner())
 }
 
-impl Bus for InprocEndpoint {
-    fn send(&mut self, frame: &Frame) -> Result<(), BusError> {
+impl InprocEndpoint {
+    /// Queues `frames` for every other endpoint under one lock, waking only those waiting.
+    fn deliver(&self, frames: &[Frame]) {
         let (mutex, ready) = &*self.shared;
         let mut shared = lock(mutex);
         for (i, queue) in shared.queues.iter_mut().enumerate() {
             if Some(i) != self.index {
-                queue.push_back(*frame);
+                queue.extend(frames.iter().copied());
             }
         }
-        ready.notify_all();
+        if shared.waiting > 0 {
+            ready.notify_all();
+        }
+    }
+}
+
+impl Bus for InprocEndpoint {
+    fn send(&mut self, frame: &Frame) -> Result<(), BusError> {
+        self.deliver(std::slice::from_ref(frame));
+        Ok(())
+    }
+
+    fn send_all(&mut self, frames: &[Frame]) -> Result<(), BusError> {
+        self.deliver(frames);
         Ok(())
     }
 
@@ -82,20 +98,27 @@ impl Bus for InprocEndpoint {
             return Ok(None);
         };
         let (mutex, ready) = &*self.shared;
-        let deadline = Instant::now() + timeout;
         let mut shared = lock(mutex);
+        // The clock is read only when there is something to wait for.
+        let mut deadline = None;
         loop {
             if let Some(frame) = shared.queues.get_mut(index).and_then(VecDeque::pop_front) {
                 return Ok(Some(frame));
             }
-            let now = Instant::now();
-            if now >= deadline {
+            if timeout.is_zero() {
                 return Ok(None);
             }
+            let now = Instant::now();
+            let until = *deadline.get_or_insert(now + timeout);
+            if now >= until {
+                return Ok(None);
+            }
+            shared.waiting += 1;
             shared = ready
-                .wait_timeout(shared, deadline - now)
+                .wait_timeout(shared, until - now)
                 .map(|(guard, _)| guard)
                 .unwrap_or_else(|poisoned| poisoned.into_inner().0);
+            shared.waiting -= 1;
         }
     }
 

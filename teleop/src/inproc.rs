@@ -74,6 +74,7 @@ impl InprocRobot {
             plant: Plant::default(),
             teleop_plan: Vec::new(),
             plots: options.out_dir.is_some(),
+            text_logs: true,
             out_dir: options.out_dir,
             progress: false,
             stop: Some(Arc::clone(&stop)),

@@ -104,15 +104,17 @@ pub fn cycle(
         stats.frames_sent += 1;
     }
     peers(sim.cycle())?;
-    let deadline = Instant::now() + reply_timeout;
+    // What has arrived is taken first; the clock is read only when the command is still to
+    // come (never in-process, where the controller has already answered).
+    let mut deadline = None;
     let mut commanded = false;
     loop {
-        let wait = if commanded {
-            Duration::ZERO
-        } else {
-            deadline.saturating_duration_since(Instant::now())
-        };
-        match bus.recv(wait)? {
+        let mut received = bus.recv(Duration::ZERO)?;
+        if received.is_none() && !commanded {
+            let until = *deadline.get_or_insert_with(|| Instant::now() + reply_timeout);
+            received = bus.recv(until.saturating_duration_since(Instant::now()))?;
+        }
+        match received {
             Some(frame) => {
                 stats.frames_received += 1;
                 recorder.frame(time_s, &frame)?;

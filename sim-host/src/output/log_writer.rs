@@ -95,8 +95,11 @@ impl Sinks {
                 }
             }
             Record::Cycle { row, sample } => {
-                if let (Some(foxglove), Some(sample)) = (&mut self.foxglove, sample) {
-                    foxglove.cycle(sample);
+                if let Some(foxglove) = &mut self.foxglove {
+                    foxglove.telemetry(row);
+                    if let Some(sample) = sample {
+                        foxglove.cycle(sample);
+                    }
                 }
                 if let Some(csv) = &mut self.csv {
                     csv.write(row)?;
@@ -175,10 +178,19 @@ impl LogWriter {
         })
     }
 
-    /// Adds `record`; hands the batch over when it is full or old enough.
+    /// Adds `record`; hands the batch over when it is full.
     pub fn push(&mut self, record: Record) -> Result<(), OutputError> {
         self.batch.push(record);
-        if self.batch.len() >= BATCH || self.since.elapsed() >= HANDOFF_EVERY {
+        if self.batch.len() >= BATCH {
+            self.hand_off()?;
+        }
+        Ok(())
+    }
+
+    /// Hands the batch over if it is old enough: once a cycle (a clock read per record would
+    /// cost more than the record).
+    pub fn tick(&mut self) -> Result<(), OutputError> {
+        if self.since.elapsed() >= HANDOFF_EVERY {
             self.hand_off()?;
         }
         Ok(())

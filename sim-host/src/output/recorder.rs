@@ -131,6 +131,7 @@ impl Recorder {
                 row: row.clone(),
                 sample,
             })?;
+            writer.tick()?;
         }
         if !self.discard_rows {
             self.rows.push(row);

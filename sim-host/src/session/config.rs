@@ -79,6 +79,10 @@ pub struct SessionConfig {
     pub out_dir: Option<PathBuf>,
     /// Whether to draw the PNG plots.
     pub plots: bool,
+    /// With an output folder: write bus.log and telemetry.csv as the run goes. Without them,
+    /// `run.mcap` alone holds the bus and the telemetry, and `sim-host export` makes the text
+    /// logs from it.
+    pub text_logs: bool,
     /// Show a progress bar.
     pub progress: bool,
     /// Set (by a Ctrl-C handler, say) to end the run early; the outputs are still written.

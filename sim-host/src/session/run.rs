@@ -154,6 +154,10 @@ fn open_recorder(
                 path: dir.clone(),
                 source,
             })?;
+            if !config.text_logs {
+                // The MCAP, opened next, holds the bus and the telemetry.
+                return Ok(Recorder::in_memory());
+            }
             let (log, csv) = (dir.join("bus.log"), dir.join("telemetry.csv"));
             files.push(log.clone());
             files.push(csv.clone());

@@ -65,6 +65,7 @@ pub fn config(
         teleop_plan: plan,
         out_dir: None,
         plots: false,
+        text_logs: true,
         progress: false,
         stop: None,
         segments,

@@ -4,6 +4,7 @@
 #![cfg_attr(not(test), warn(clippy::too_many_lines))]
 
 mod campaign;
+mod export;
 mod report;
 mod run;
 
@@ -14,6 +15,7 @@ use clap::{Parser, Subcommand};
 use sim_host::robot::model::DEFAULT_MODEL;
 
 use crate::campaign::CampaignArgs;
+use crate::export::ExportArgs;
 use crate::run::RunArgs;
 
 /// The hybrid wheel–leg robot in MuJoCo, on a CAN bus.
@@ -55,6 +57,12 @@ enum Command {
     /// Examples: sim-host campaign --trials 100;  sim-host campaign --seed 17 --scenario W;
     /// sim-host campaign --shard 0/4 --results a.json;  sim-host campaign --merge a.json b.json
     Campaign(Box<CampaignArgs>),
+    /// Write a run's text logs — bus.log (candump `-L`) and telemetry.csv — from its run.mcap:
+    /// the same files the run writes itself, byte for byte. A file cut short (a killed run) is
+    /// exported up to its last whole chunk, and the exit code is 1.
+    ///
+    /// Example: sim-host export out/sim/run.mcap --out out/text
+    Export(ExportArgs),
 }
 
 fn main() -> ExitCode {
@@ -66,6 +74,13 @@ fn main() -> ExitCode {
             Ok(()) => ExitCode::SUCCESS,
             Err(e) => {
                 eprintln!("sim-host campaign: {e}");
+                ExitCode::FAILURE
+            }
+        },
+        Command::Export(args) => match export::run(&args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(message) => {
+                eprintln!("sim-host export: {message}");
                 ExitCode::FAILURE
             }
         },

@@ -177,6 +177,10 @@ pub(crate) struct RunArgs {
     /// Skip the PNG plots.
     #[arg(long)]
     pub(crate) no_plots: bool,
+    /// Write the bus and the telemetry only into run.mcap, not also as bus.log and
+    /// telemetry.csv: `sim-host export` makes those from it afterwards, byte for byte.
+    #[arg(long)]
+    pub(crate) no_text_logs: bool,
     /// Keep nothing on disk: no logs, no plots, no MCAP. A bare run, to time the loop against
     /// one with every output, or to soak for hours.
     #[arg(long, conflicts_with_all = ["out", "scenario", "scene", "render_every"])]
@@ -384,6 +388,7 @@ fn session_config(
         faults: args.faults.clone(),
         out_dir: (!args.no_out).then(|| args.out.clone()),
         plots: !args.no_plots,
+        text_logs: !args.no_text_logs,
         progress: !args.no_progress,
         frames: args.render_every.map(|every_cycles| FrameSettings {
             dir: args.out.join("frames"),

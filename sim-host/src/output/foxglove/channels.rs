@@ -24,6 +24,7 @@ pub(super) struct Channels {
     pub(super) wheels: Channel<messages::WheelFeedback>,
     pub(super) status: Channel<messages::ControllerStatus>,
     pub(super) can: Channel<messages::CanFrames>,
+    pub(super) telemetry: Channel<messages::Telemetry>,
     description: Arc<RawChannel>,
     /// The robot description's message, encoded once: the URDF does not change.
     description_json: Vec<u8>,
@@ -59,6 +60,7 @@ impl Channels {
             wheels: context.channel_builder("/wheels").build(),
             status: context.channel_builder("/controller/status").build(),
             can: context.channel_builder("/can").build(),
+            telemetry: context.channel_builder("/telemetry").build(),
             description,
             description_json: json!({ "data": urdf }).to_string().into_bytes(),
         })

@@ -15,6 +15,9 @@ pub struct CanFrames {
 /// One frame on the bus.
 #[derive(foxglove::Encode)]
 pub struct CanFrame {
+    /// When it was seen, s (simulated in lockstep, wall clock in real time): the candump log's
+    /// time, exported from here.
+    pub time_s: f64,
     /// The 11-bit identifier.
     pub id: u32,
     /// The message's name in the DBC (`unknown` for an identifier the protocol lacks).
@@ -78,4 +81,28 @@ pub struct JointState {
     pub velocity: Vec<f64>,
     /// Actuator effort, N·m.
     pub effort: Vec<f64>,
+}
+
+/// The simulator's ground truth of one control cycle (`/telemetry`): the telemetry CSV's row,
+/// exported from here.
+#[derive(foxglove::Encode)]
+pub struct Telemetry {
+    /// Simulated time, s.
+    pub time_s: f64,
+    /// Torso centre in the world, m.
+    pub torso_pos_m: [f64; 3],
+    /// Torso roll, pitch (+ nose down), yaw (+ left), degrees.
+    pub torso_rpy_deg: [f64; 3],
+    /// Leg joint angles in the protocol's joint order, rad.
+    pub leg_joint_rad: [f64; 16],
+    /// Wheel torques, left and right, N·m.
+    pub wheel_torque_nm: [f64; 2],
+    /// Wheel speeds, left and right, rad/s.
+    pub wheel_speed_rad_s: [f64; 2],
+    /// Normal force on each foot (FL, FR, BL, BR), N.
+    pub foot_force_n: [f64; 4],
+    /// Whether a part other than the wheels and feet touches the ground.
+    pub body_contact: bool,
+    /// The controller's mode as the DBC names it, empty before its first status.
+    pub mode: &'static str,
 }

@@ -9,7 +9,8 @@
 //! | `/wheels` | `WheelFeedback` | what the wheel drive sent: speed and torque of each wheel |
 //! | `/controller/status` | `ControllerStatus` | the controller's mode, faults, pitch, roll, body height |
 //! | `/controller/log` | `foxglove.Log` | a line per change of mode or fault flags |
-//! | `/can` | `CanFrames` | every frame on the bus (id, message name, data), a message per control cycle |
+//! | `/can` | `CanFrames` | every frame on the bus (time, id, message name, data), a message per control cycle: the candump log's content |
+//! | `/telemetry` | `Telemetry` | the simulator's ground truth each control cycle: the telemetry CSV's row |
 //! | `/robot_description` | JSON `std_msgs/String` | the URDF (also attached to the MCAP, and `robot.urdf` beside it) |
 //! | `/camera` | `foxglove.CompressedImage` | the rendered frames, PNG (only with frames: feature `renderer`) |
 //!
@@ -36,6 +37,7 @@ use protocol::signal::WireField;
 use protocol::{decode_frame, AnyMessage, ControllerMode, FaultFlags, Frame};
 
 use crate::output::output_error::OutputError;
+use crate::output::telemetry::TelemetryRow;
 use crate::session::simulator::Simulator;
 use bodies::{RobotTree, WORLD_FRAME};
 use channels::{open_mcap, Channels};
@@ -223,6 +225,7 @@ impl FoxgloveLog {
         let decoded = decode_frame(frame.id(), frame.data()).ok();
         let name = protocol::MessageId::from_raw(frame.id()).map(|id| id.layout().name);
         self.pending_can.0.push(messages::CanFrame {
+            time_s,
             id: u32::from(frame.id()),
             name: name.unwrap_or("unknown"),
             data: foxglove::bytes::Bytes::copy_from_slice(frame.data()),
@@ -309,6 +312,24 @@ impl FoxgloveLog {
         if self.description_due.now(time_s, DESCRIPTION_HZ) {
             self.channels.describe(time_s);
         }
+    }
+
+    /// Logs the simulator's ground truth of a cycle (`/telemetry`).
+    pub fn telemetry(&self, row: &TelemetryRow) {
+        let message = messages::Telemetry {
+            time_s: row.time_s,
+            torso_pos_m: row.torso_pos_m,
+            torso_rpy_deg: row.torso_rpy_deg,
+            leg_joint_rad: *row.leg_joint_rad.as_array(),
+            wheel_torque_nm: row.wheel_torque_nm,
+            wheel_speed_rad_s: row.wheel_speed_rad_s,
+            foot_force_n: row.foot_force_n,
+            body_contact: row.body_contact,
+            mode: row.mode.map_or("", ControllerMode::label),
+        };
+        self.channels
+            .telemetry
+            .log_with_time(&message, nanos(row.time_s));
     }
 
     /// Logs the frames seen since the last cycle as one `/can` message.
