@@ -258,6 +258,24 @@ fn a_run_killed_after_ten_seconds_leaves_its_logs_readable_up_to_a_second_before
         last_frame_s >= least_s,
         "bus.log ends at {last_frame_s} s, killed at about {simulated_at_kill_s:.2} s"
     );
+    // The binary log too: its export says the file was cut short and holds as much.
+    let exported = out.join("exported");
+    let export = sim_host()
+        .arg("export")
+        .arg(out.join("run.mcap"))
+        .arg("--out")
+        .arg(&exported)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&export.stderr);
+    assert_eq!(export.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("ends early"), "{stderr}");
+    let exported_s = bus_log_end_s(&exported);
+    println!("MEASURED run.mcap exported up to {exported_s} s");
+    assert!(
+        exported_s >= least_s,
+        "run.mcap exports up to {exported_s} s, killed at about {simulated_at_kill_s:.2} s"
+    );
 }
 
 /// The figure after `label` in `sim-host run`'s report (`simulated        12.34 s …`).

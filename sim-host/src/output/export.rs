@@ -3,12 +3,11 @@
 //! equals the logs the run wrote itself, byte for byte. The messages are decoded by the
 //! schemas the file carries, not by this build's message types.
 //!
-//! A file cut short (a killed run: the MCAP's last chunk and its summary never written) is
-//! exported up to its last whole chunk, and the export reports the cut as an error naming how
-//! far it got.
+//! A file cut short (a killed run: its last chunk unfinished, its summary never written) is
+//! exported up to the cut, and the export reports the cut as an error naming how far it got.
 
 use std::fs::File;
-use std::io::{BufWriter, Read};
+use std::io::{BufWriter, Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use mcap::records::Record;
@@ -95,6 +94,13 @@ pub fn export(mcap: &Path, targets: &ExportTargets) -> Result<Exported, ExportEr
     })?;
     let mut sinks = TextSinks::create(targets)?;
     let mut decoder = Decoder::new(mcap);
+    // A whole MCAP ends with the magic its writer writes last: without it the file was cut
+    // short (a killed run leaves its last chunk's header unfinished), and a reading error
+    // where it ends is the cut, not damage.
+    let cut = cut_short(&mut file).map_err(|source| ExportError::Read {
+        path: mcap.to_owned(),
+        source,
+    })?;
     let mut reader = LinearReader::new();
     while let Some(event) = reader.next_event() {
         match event {
@@ -112,7 +118,7 @@ pub fn export(mcap: &Path, targets: &ExportTargets) -> Result<Exported, ExportEr
                     mcap::parse_record(opcode, data).map_err(|source| decoder.mcap(source))?;
                 decoder.record(record, &mut sinks)?;
             }
-            Err(mcap::McapError::UnexpectedEof) => {
+            Err(_) if cut => {
                 let exported = sinks.finish()?;
                 return Err(ExportError::CutShort {
                     path: mcap.to_owned(),
@@ -123,6 +129,19 @@ pub fn export(mcap: &Path, targets: &ExportTargets) -> Result<Exported, ExportEr
         }
     }
     Ok(sinks.finish()?)
+}
+
+/// Whether `file` is an MCAP cut short: it starts with the MCAP magic and does not end with
+/// it. Reads from its start again after.
+fn cut_short(file: &mut File) -> std::io::Result<bool> {
+    let mut magic_at = |from: SeekFrom| -> std::io::Result<bool> {
+        let mut bytes = [0; 8];
+        // A file shorter than the magic has neither.
+        Ok(file.seek(from).is_ok() && file.read_exact(&mut bytes).is_ok() && bytes == *mcap::MAGIC)
+    };
+    let cut = magic_at(SeekFrom::Start(0))? && !magic_at(SeekFrom::End(-8))?;
+    file.seek(SeekFrom::Start(0))?;
+    Ok(cut)
 }
 
 /// The text logs being written.

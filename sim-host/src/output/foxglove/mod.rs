@@ -15,9 +15,9 @@
 //! | `/camera` | `foxglove.CompressedImage` | the rendered frames, PNG (only with frames: feature `renderer`) |
 //!
 //! The log's own messages ([`messages`]) are protobuf with their schemas in the file. Log times
-//! are simulation time. The MCAP is lz4-chunked and flushed with the other logs (at
-//! least once a second), so a killed run leaves it readable up to its last flush (MCAP readers
-//! recover the chunks of a file without a footer).
+//! are simulation time. The MCAP is lz4-chunked and flushed with the other logs (a chunk ends
+//! at each flush), so a killed run leaves it whole up to its last flush but for an unfinished
+//! last chunk: `sim-host export` ([`crate::output::export`]) reads it up to there.
 
 pub mod bodies;
 mod channels;
