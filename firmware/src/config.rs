@@ -1,6 +1,7 @@
 //! Every tunable of the controller in one value, with the report's numbers as defaults.
 
 use crate::control::estimator::EstimatorConfig;
+use crate::control::heading::HeadingConfig;
 use crate::control::steering::SteeringConfig;
 use crate::control::stop::StopConfig;
 use crate::legs::blocked::BlockedConfig;
@@ -51,6 +52,8 @@ pub struct Config {
     pub wheel_speed_rad_s: f32,
     /// Steering: the wheel track and the yaw-rate limits.
     pub steering: SteeringConfig,
+    /// The trot's heading hold.
+    pub heading: HeadingConfig,
     /// Per-wheel torque limit, N·m.
     pub wheel_torque_limit_nm: f32,
     /// Turn (differential) speed loop.
@@ -112,6 +115,7 @@ impl Config {
         pose_tolerance_rad: 0.01,
         wheel_speed_rad_s: 4.0,
         steering: SteeringConfig::ROBOT,
+        heading: HeadingConfig::ROBOT,
         wheel_torque_limit_nm: WHEEL_TORQUE_LIMIT_NM,
         turn: SpeedLoopGains::TURN,
         balance: BalanceConfig {

@@ -25,6 +25,7 @@ use protocol::{AnyMessage, DriveFlags, EStopAction, FaultFlags, Joints, Leg, Per
 use crate::config::Config;
 use crate::control::estimator::AttitudeEstimator;
 use crate::control::fsm::{Direction, Event, LegMotion, State, WheelMotion};
+use crate::control::heading::HeadingHold;
 pub use crate::control::output::{ConfigError, Output, Status};
 use crate::control::safety::{clamp_leg_targets, clamp_wheel_torques};
 use crate::control::sensors::Sensors;
@@ -121,6 +122,8 @@ pub struct Controller {
     leg_blocked: bool,
     /// Which way `Walk` trots (see [`Controller::follow_walk_direction`]).
     walk_direction: Direction,
+    /// The trot's heading hold, and the yaw rate it gives the trot this tick, rad/s.
+    heading: (HeadingHold, f32),
 }
 
 impl Controller {
@@ -168,6 +171,7 @@ impl Controller {
             blocked_swings: BlockedSwings::new(),
             leg_blocked: false,
             walk_direction: Direction::Forward,
+            heading: (HeadingHold::default(), 0.0),
         })
     }
 
@@ -275,6 +279,7 @@ impl Controller {
             }
             State::Legs(_) | State::Standing(_) => {
                 self.follow_walk_direction();
+                self.hold_heading(dt_s);
                 self.leg_goal(depth_m);
                 let rate = match self.state {
                     State::Legs(motion) if motion.trotting() => self.config.gait_rate_per_s,

@@ -6,6 +6,7 @@
 pub mod controller;
 pub mod estimator;
 pub mod fsm;
+pub mod heading;
 pub mod output;
 pub mod safety;
 pub mod sensors;

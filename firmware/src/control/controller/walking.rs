@@ -15,10 +15,7 @@ impl Controller {
     /// speed's share of the walking limit the operator is told of
     /// ([`protocol::motion_limits::WALK_LIMITS`]).
     pub fn trot_motion(&self) -> Option<(Direction, TrotCommand)> {
-        let yaw_rate_rad_s = self
-            .config
-            .steering
-            .trot_yaw_rad_s(self.teleop.yaw_rate_rad_s);
+        let yaw_rate_rad_s = self.heading.1;
         let stride_share = match self.state {
             State::Legs(LegMotion::Trot(direction)) => {
                 return Some((
@@ -55,6 +52,27 @@ impl Controller {
                 yaw_rate_rad_s,
             },
         ))
+    }
+
+    /// One tick of the heading hold ([`crate::control::heading`]): while the legs trot, the
+    /// yaw rate the trot takes (the operator's, or the hold's correction once the gyro's bias
+    /// is measured); otherwise the hold restarts.
+    pub(super) fn hold_heading(&mut self, dt_s: f32) {
+        let operator_rad_s = self
+            .config
+            .steering
+            .trot_yaw_rad_s(self.teleop.yaw_rate_rad_s);
+        let trotting = matches!(self.state, State::Legs(motion) if motion.trotting());
+        let held = trotting && self.sensors.estimator().calibrated();
+        let [_, _, measured_rad_s] = self.sensors.angular_rate_rad_s;
+        let (hold, yaw_rate_rad_s) = &mut self.heading;
+        *yaw_rate_rad_s = hold.yaw_rate_rad_s(
+            &self.config.heading,
+            held,
+            operator_rad_s,
+            measured_rad_s,
+            dt_s,
+        );
     }
 
     /// In `Walk`, turns the trot round when the operator's speed changes sign (past
