@@ -113,6 +113,22 @@ fn what_is_not_a_runs_mcap_is_refused_naming_the_file() {
     let text = out.join("text.mcap");
     std::fs::write(&text, "(0.000000) vcan0 020#00\n").unwrap();
     let error = export(&text, &targets(&out)).unwrap_err();
-    assert!(matches!(error, ExportError::Mcap { .. }), "{error}");
+    assert!(matches!(error, ExportError::NotMcap { .. }), "{error}");
     assert!(error.to_string().contains("text.mcap"));
+    // Checked before anything is written: no text log was created.
+    assert!(!out.join("bus.log").exists() && !out.join("telemetry.csv").exists());
+}
+
+#[test]
+fn an_mcap_without_the_topics_the_text_logs_need_is_refused_naming_them() {
+    let out = dir("no-topics");
+    let path = out.join("empty.mcap");
+    let file = std::io::BufWriter::new(std::fs::File::create(&path).unwrap());
+    mcap::Writer::new(file).unwrap().finish().unwrap();
+    let error = export(&path, &targets(&out)).unwrap_err();
+    let ExportError::MissingTopic { topic, .. } = &error else {
+        panic!("not reported as a missing topic: {error}");
+    };
+    assert_eq!(*topic, "/can");
+    assert!(error.to_string().contains("empty.mcap"), "{error}");
 }

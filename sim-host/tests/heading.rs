@@ -96,6 +96,45 @@ fn check(mode: TeleopMode) {
     }
 }
 
+/// `walk` at no speed and no yaw rate keeps its feet down, held or not: a hold that corrected
+/// the body's sway there would march the robot on the spot.
+#[test]
+fn walk_at_no_speed_keeps_every_foot_down_once_the_bias_is_measured() {
+    for seed in [100, 101, 102] {
+        let plant = Draws::of(seed).plant(Drives::Rated.ratings());
+        let plan = vec![
+            PlanStep::at(0.0, TeleopMode::Stand),
+            PlanStep::at(TROT_AT_S, TeleopMode::Walk),
+        ];
+        let mut rig = Rig::with_plant(
+            Path::new(DEFAULT_MODEL),
+            plan,
+            &Faults::default(),
+            &Faults::default(),
+            plant,
+        )
+        .unwrap();
+        // A second for the legs to go from the stand to the trot's stance line.
+        rig.run_until(TROT_AT_S + 1.0).unwrap();
+        let controller = rig.controller().unwrap().node().controller();
+        assert!(controller.sensors().estimator().calibrated());
+        let start = rig.sim().physics().torso().pos_m;
+        while rig.time_s() < TROT_AT_S + 5.0 {
+            rig.step().unwrap();
+            let feet = rig.sim().physics().ground_contacts().feet;
+            assert!(
+                feet.iter().all(|&down| down),
+                "robot {seed}: a foot lifted at {:.2} s in walk at no speed",
+                rig.time_s()
+            );
+        }
+        let end = rig.sim().physics().torso().pos_m;
+        let moved_m = (end[0] - start[0]).hypot(end[1] - start[1]);
+        // Planted feet and compliant legs: the body settles a little, it does not walk off.
+        assert!(moved_m < 0.05, "robot {seed} moved {moved_m:.3} m");
+    }
+}
+
 #[test]
 fn robots_trotting_forward_hold_their_heading() {
     check(TeleopMode::TrotForward);

@@ -8,8 +8,8 @@ the front-left leg's joints, looking the joints up by name, and the trot builds 
 after the loop the two figures are drawn (saved as PNG: there is no screen). Only the viewer and
 the wall-clock pacing are left out: as fast as it goes.
 
-`--hoisted` is the same loop with the name lookups taken out of it, for a Python loop as fast as
-the report's logic allows.
+`--hoisted` is the same program with the joints' lookups by name taken out of the loop, the
+rest as written.
 
 usage: report_loop.py MODEL.xml SECONDS OUT_DIR [--hoisted]
 prints JSON: {"steps": N, "loop_s": T, "steps_per_s": N / T}

@@ -3,21 +3,19 @@
 //! # Why
 //!
 //! A trot that strides the same on both sides still turns: robots as built walk circles on
-//! flat ground (feet slipping unevenly, a centre of mass off to a side, unequal drives), up to
-//! 150° in 24 s of `L` on the campaign's robots. An operator corrects it by hand; a robot
+//! flat ground (feet slipping unevenly, a centre of mass off to a side, unequal drives), some
+//! by a quarter turn in half a minute. An operator corrects it by hand; a robot
 //! meant to reach a step squarely, or to walk a course by itself, must hold its heading.
 //!
 //! # How
 //!
 //! The gyro's yaw rate, with its bias removed, integrates to the heading turned since the
 //! operator last steered; low-passed over half a stride (the trot swings the body's heading
-//! back and forth by up to 10° each stride), a PI law on it asks the trot for a yaw rate
-//! ([`crate::legs::gait::Trot::strides`] turns by it), within [`HeadingConfig::max_rad_s`].
-//! The operator steering takes over and the held heading restarts where they leave off.
-//! Measured on 40 of the campaign's robots, 24 s of `L` after standing still: the largest
-//! turn 152.7° unheld, 7.3° held (`K`: 45.0° and 9.1°), and two unheld robots that walked a
-//! circle fell; none held (`sim-host/tests/heading.rs`). Gains twice as high made the hold
-//! chase the stride's swing and a robot fell.
+//! back and forth each stride, which is no turn to correct), a PI law on it asks the trot
+//! for a yaw rate ([`crate::legs::gait::Trot::strides`] turns by it), within
+//! [`HeadingConfig::max_rad_s`]. The operator steering takes over and the held heading
+//! restarts where they leave off; a trot at no speed is not held (a correction would lift
+//! feet that stay down there). docs/firmware.md has the measurements.
 //!
 //! The hold needs the gyro's bias about the vertical, which gravity does not show: it is held
 //! only once the estimator has measured the bias standing still
@@ -38,7 +36,7 @@ pub struct HeadingConfig {
     /// An operator's yaw rate past this is steering, rad/s.
     pub steering_rad_s: f32,
     /// Time constant of the low-pass on the heading, s: the trot swings the body's heading
-    /// back and forth by several degrees each stride, which is no turn to correct.
+    /// back and forth each stride, which is no turn to correct.
     pub smoothing_s: f32,
 }
 

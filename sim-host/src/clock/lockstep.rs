@@ -95,7 +95,8 @@ pub fn cycle(
     let mut outgoing = sim.frames_due()?;
     if let Some(sync) = sim.sync_frame()? {
         // SYNC has its slot in the schedule, which no node fills: there is room.
-        let _ = outgoing.push(sync);
+        let pushed = outgoing.push(sync);
+        debug_assert!(pushed.is_ok(), "the schedule has a slot for SYNC");
     }
     // In one call: a controller in another process wakes once for the cycle, not per frame.
     bus.send_all(&outgoing)?;

@@ -1,9 +1,10 @@
 //! The run's log files written off the simulation's thread: the recorder hands its records over
 //! in batches (at most every [`HANDOFF_EVERY`] or [`BATCH`] records, never a hand-off per
 //! cycle), and a writer thread formats and writes them — the candump log, the telemetry CSV and
-//! the Foxglove MCAP — and flushes them every [`FLUSH_EVERY`]. Memory stays bounded and is allocated once: [`BATCHES`] batches and the
-//! one being filled, which go round — the simulation waits for an emptied one rather than
-//! making another.
+//! the Foxglove MCAP — and flushes them every [`FLUSH_EVERY`]. Memory stays bounded and is
+//! allocated once: [`BATCHES`] batches and the one being filled, which go round
+//! ([`crate::output::handoff`]) — the simulation waits for an emptied one rather than making
+//! another.
 //!
 //! A run killed outright leaves the files readable up to within a hand-off and a flush of the
 //! kill (under half a second); a writer that fails (a full disk) stops the run at its next

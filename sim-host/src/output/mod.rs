@@ -1,9 +1,10 @@
-//! What a run leaves for its user: the [`telemetry`] rows and their [`telemetry_csv`] file, the
-//! [`recorder`] that streams the bus to a candump log through the [`log_writer`] thread (batches passed by [`handoff`]), the figures per segment ([`metrics`],
-//! [`summary`], the obstacles' [`crossings`]), the [`plots`], rendered frames ([`render`],
-//! feature `renderer`) and their [`animation`], the [`foxglove`] MCAP log and live server and the text logs [`export`]ed from it, and the interactive
-//! [`viewer`] (feature `viewer`); [`output_error`]
-//! names the file that failed.
+//! What a run leaves for its user: the [`telemetry`] rows and their [`telemetry_csv`] file;
+//! the [`recorder`] that streams the bus to a candump log through the [`log_writer`] thread
+//! (batches passed by [`handoff`]); the figures per segment ([`metrics`], [`summary`], the
+//! obstacles' [`crossings`]); the [`plots`]; rendered frames ([`render`], feature
+//! `renderer`) and their [`animation`]; the [`foxglove`] MCAP log and live server, and the
+//! text logs [`export`]ed from it; the interactive [`viewer`] (feature `viewer`).
+//! [`output_error`] names the file that failed.
 
 pub mod animation;
 pub mod crossings;

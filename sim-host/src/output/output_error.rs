@@ -50,7 +50,7 @@ pub enum OutputError {
         source: foxglove::FoxgloveError,
     },
     /// The model has more coordinates than the Foxglove log's samples hold.
-    #[error("the model has {coordinates} position coordinates; the Foxglove log holds at most {max} (a scene with fewer free bodies, or run without an output folder)")]
+    #[error("the model has {coordinates} position coordinates; the Foxglove log holds at most {max} (a scene with fewer free bodies, or run without an output folder and without --foxglove-port)")]
     TooManyCoordinates {
         /// The model's `nq`.
         coordinates: usize,

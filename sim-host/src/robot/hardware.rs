@@ -160,7 +160,8 @@ impl Hardware {
             // A node that has not heard the controller's announcement yet sends nothing. The
             // schedule has a slot per frame, so there is always room.
             if let Some(frame) = sealed {
-                let _ = frames.push(frame);
+                let pushed = frames.push(frame);
+                debug_assert!(pushed.is_ok(), "a slot of the schedule per frame");
             }
         }
         Ok(frames)

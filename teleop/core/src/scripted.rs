@@ -131,7 +131,8 @@ impl ScriptedTeleop {
         if now_us >= self.next_send_us {
             self.next_send_us = now_us - now_us % PERIOD_US + PERIOD_US;
             if let Some(command) = self.command(now_us)? {
-                let _ = frames.push(command);
+                let pushed = frames.push(command);
+                debug_assert!(pushed.is_ok(), "room for the command and the heartbeat");
             }
         }
         if now_us >= self.next_heartbeat_us {
@@ -143,7 +144,8 @@ impl ScriptedTeleop {
                 uptime: Millis::from_raw(uptime_ms).unwrap_or(Millis::saturating_from_si(0.0)),
             });
             if let Some(heartbeat) = self.link.seal(&heartbeat)? {
-                let _ = frames.push(heartbeat);
+                let pushed = frames.push(heartbeat);
+                debug_assert!(pushed.is_ok(), "room for the command and the heartbeat");
             }
         }
         Ok(frames)

@@ -54,16 +54,19 @@ impl Controller {
         ))
     }
 
-    /// One tick of the heading hold ([`crate::control::heading`]): while the legs trot, the
+    /// One tick of the heading hold ([`crate::control::heading`]): while the legs stride, the
     /// yaw rate the trot takes (the operator's, or the hold's correction once the gyro's bias
-    /// is measured); otherwise the hold restarts.
+    /// is measured); otherwise the hold restarts. A trot at no speed holds nothing: a
+    /// correction would lift its feet, which stay down there.
     pub(super) fn hold_heading(&mut self, dt_s: f32) {
         let operator_rad_s = self
             .config
             .steering
             .trot_yaw_rad_s(self.teleop.yaw_rate_rad_s);
-        let trotting = matches!(self.state, State::Legs(motion) if motion.trotting());
-        let held = trotting && self.sensors.estimator().calibrated();
+        let striding = self
+            .trot_motion()
+            .is_some_and(|(_, command)| command.stride_share > 0.0);
+        let held = striding && self.sensors.estimator().calibrated();
         let [_, _, measured_rad_s] = self.sensors.angular_rate_rad_s;
         let (hold, yaw_rate_rad_s) = &mut self.heading;
         *yaw_rate_rad_s = hold.yaw_rate_rad_s(

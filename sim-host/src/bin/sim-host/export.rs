@@ -16,6 +16,9 @@ pub(crate) struct ExportArgs {
     /// The SocketCAN interface the candump lines name (canplayer replays on it).
     #[arg(long, default_value = "vcan0")]
     pub(crate) bus: String,
+    /// Replace bus.log and telemetry.csv where they exist (a run's own, or an earlier export).
+    #[arg(long)]
+    pub(crate) force: bool,
 }
 
 /// Exports and prints what was written; a file cut short is exported up to the cut and
@@ -31,6 +34,15 @@ pub(crate) fn run(args: &ExportArgs) -> Result<(), String> {
         candump: Some((dir.join("bus.log"), args.bus.clone())),
         csv: Some(dir.join("telemetry.csv")),
     };
+    let candump = targets.candump.iter().map(|(path, _)| path);
+    if let Some(taken) = candump.chain(&targets.csv).find(|path| path.exists()) {
+        if !args.force {
+            return Err(format!(
+                "{} exists (the run's own log, or an earlier export): give another folder with --out, or --force to replace it",
+                taken.display()
+            ));
+        }
+    }
     let result = export(&args.mcap, &targets);
     let exported = match &result {
         Ok(exported) | Err(ExportError::CutShort { exported, .. }) => Some(*exported),

@@ -59,7 +59,8 @@ enum Command {
     Campaign(Box<CampaignArgs>),
     /// Write a run's text logs — bus.log (candump `-L`) and telemetry.csv — from its run.mcap:
     /// the same files the run writes itself, byte for byte. A file cut short (a killed run) is
-    /// exported up to the cut, and the exit code is 1.
+    /// exported up to the cut, and the exit code is 1. Existing text logs are kept unless
+    /// `--force`.
     ///
     /// Example: sim-host export out/sim/run.mcap --out out/text
     Export(ExportArgs),

@@ -17,7 +17,6 @@ pub(crate) fn print(
     if report.interrupted {
         println!("interrupted      (Ctrl-C) — outputs cover the simulated part");
     }
-    let last = report.rows.last();
     println!(
         "simulated        {:.2} s in {:.2} s wall ({:.1}x real time)",
         s.sim_s,
@@ -50,20 +49,7 @@ pub(crate) fn print(
         println!("  on feedback    {tx:?}");
         println!("  on commands    {rx:?}");
     }
-    if let Some(resident) = report.resident.describe() {
-        println!("memory           resident {resident}");
-    }
-    if let Some(row) = last {
-        println!(
-            "torso at end     x {:.3} m, y {:.3} m, z {:.3} m, roll {:.1}°, pitch {:.1}°, yaw {:.1}°",
-            row.torso_pos_m[0],
-            row.torso_pos_m[1],
-            row.torso_pos_m[2],
-            row.torso_rpy_deg[0],
-            row.torso_rpy_deg[1],
-            row.torso_rpy_deg[2]
-        );
-    }
+    print_end(report);
     if let Some(s) = scenario {
         let path = args.out.join("summary.json");
         Summary::from_stats(
@@ -89,4 +75,22 @@ pub(crate) fn print(
         println!("wrote            {}", file.display());
     }
     Ok(())
+}
+
+/// The memory the run held and where the torso ended.
+fn print_end(report: &SessionReport) {
+    if let Some(resident) = report.resident.describe() {
+        println!("memory           resident {resident}");
+    }
+    if let Some(row) = report.rows.last() {
+        println!(
+            "torso at end     x {:.3} m, y {:.3} m, z {:.3} m, roll {:.1}°, pitch {:.1}°, yaw {:.1}°",
+            row.torso_pos_m[0],
+            row.torso_pos_m[1],
+            row.torso_pos_m[2],
+            row.torso_rpy_deg[0],
+            row.torso_rpy_deg[1],
+            row.torso_rpy_deg[2]
+        );
+    }
 }

@@ -15,6 +15,10 @@ use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader};
 use prost_reflect::{DescriptorPool, DynamicMessage, MessageDescriptor, ReflectMessage, Value};
 use protocol::{ControllerMode, Frame, Joints};
 
+mod error;
+
+pub use error::{ExportError, MessageFault};
+
 use crate::output::output_error::OutputError;
 use crate::output::telemetry::TelemetryRow;
 use crate::output::telemetry_csv::CsvWriter;
@@ -40,77 +44,31 @@ pub struct Exported {
     pub last_time_s: f64,
 }
 
-/// Why an export stopped.
-#[derive(Debug, thiserror::Error)]
-pub enum ExportError {
-    /// The MCAP could not be opened or read.
-    #[error("cannot read {path}: {source}")]
-    Read {
-        /// The MCAP.
-        path: PathBuf,
-        /// What the system said.
-        source: std::io::Error,
-    },
-    /// The file ends mid-record: a run cut short. What came before was exported.
-    #[error("{path} ends early, after {:.3} s of the run (a killed run?): the text logs hold everything up to there ({} frames, {} rows)", exported.last_time_s, exported.frames, exported.rows)]
-    CutShort {
-        /// The MCAP.
-        path: PathBuf,
-        /// What was exported.
-        exported: Exported,
-    },
-    /// The file is not an MCAP this export can read.
-    #[error("{path} is not a readable MCAP: {source} (is it a sim-host run's run.mcap?)")]
-    Mcap {
-        /// The file.
-        path: PathBuf,
-        /// What the reader said.
-        source: mcap::McapError,
-    },
-    /// A topic's schema or message does not decode, or lacks a field the text log needs.
-    #[error("{path}: {topic}: {what} (written by an incompatible sim-host?)")]
-    Message {
-        /// The file.
-        path: PathBuf,
-        /// The topic.
-        topic: String,
-        /// What is wrong.
-        what: String,
-    },
-    /// A text log could not be written.
-    #[error(transparent)]
-    Output(#[from] OutputError),
-}
-
 /// The topics exported.
 const CAN: &str = "/can";
 const TELEMETRY: &str = "/telemetry";
 
-/// Exports `mcap` into `targets`.
+/// Exports `mcap` into `targets`. The file is checked to be an MCAP before any text log is
+/// created.
 pub fn export(mcap: &Path, targets: &ExportTargets) -> Result<Exported, ExportError> {
-    let mut file = File::open(mcap).map_err(|source| ExportError::Read {
+    let read_error = |source| ExportError::Read {
         path: mcap.to_owned(),
         source,
-    })?;
+    };
+    let mut file = File::open(mcap).map_err(read_error)?;
+    let (starts, ends) = magic_at_ends(&mut file).map_err(read_error)?;
+    if !starts {
+        return Err(ExportError::NotMcap {
+            path: mcap.to_owned(),
+        });
+    }
     let mut sinks = TextSinks::create(targets)?;
     let mut decoder = Decoder::new(mcap);
-    // A whole MCAP ends with the magic its writer writes last: without it the file was cut
-    // short (a killed run leaves its last chunk's header unfinished), and a reading error
-    // where it ends is the cut, not damage.
-    let cut = cut_short(&mut file).map_err(|source| ExportError::Read {
-        path: mcap.to_owned(),
-        source,
-    })?;
     let mut reader = LinearReader::new();
     while let Some(event) = reader.next_event() {
         match event {
             Ok(LinearReadEvent::ReadRequest(wanted)) => {
-                let read =
-                    file.read(reader.insert(wanted))
-                        .map_err(|source| ExportError::Read {
-                            path: mcap.to_owned(),
-                            source,
-                        })?;
+                let read = file.read(reader.insert(wanted)).map_err(read_error)?;
                 reader.notify_read(read);
             }
             Ok(LinearReadEvent::Record { data, opcode }) => {
@@ -118,7 +76,10 @@ pub fn export(mcap: &Path, targets: &ExportTargets) -> Result<Exported, ExportEr
                     mcap::parse_record(opcode, data).map_err(|source| decoder.mcap(source))?;
                 decoder.record(record, &mut sinks)?;
             }
-            Err(_) if cut => {
+            // A whole MCAP ends with the magic its writer writes last: without it the file was
+            // cut short (a killed run leaves its last chunk's header unfinished), and a reading
+            // error where it ends is the cut, not damage.
+            Err(_) if !ends => {
                 let exported = sinks.finish()?;
                 return Err(ExportError::CutShort {
                     path: mcap.to_owned(),
@@ -128,20 +89,32 @@ pub fn export(mcap: &Path, targets: &ExportTargets) -> Result<Exported, ExportEr
             Err(source) => return Err(decoder.mcap(source)),
         }
     }
+    let wanted = [
+        (targets.candump.is_some(), CAN),
+        (targets.csv.is_some(), TELEMETRY),
+    ];
+    if let Some((_, topic)) = wanted
+        .into_iter()
+        .find(|(asked, topic)| *asked && !decoder.has(topic))
+    {
+        return Err(ExportError::MissingTopic {
+            path: mcap.to_owned(),
+            topic,
+        });
+    }
     Ok(sinks.finish()?)
 }
 
-/// Whether `file` is an MCAP cut short: it starts with the MCAP magic and does not end with
-/// it. Reads from its start again after.
-fn cut_short(file: &mut File) -> std::io::Result<bool> {
+/// Whether `file` starts and ends with the MCAP magic; reads from its start again after.
+fn magic_at_ends(file: &mut File) -> std::io::Result<(bool, bool)> {
     let mut magic_at = |from: SeekFrom| -> std::io::Result<bool> {
         let mut bytes = [0; 8];
         // A file shorter than the magic has neither.
         Ok(file.seek(from).is_ok() && file.read_exact(&mut bytes).is_ok() && bytes == *mcap::MAGIC)
     };
-    let cut = magic_at(SeekFrom::Start(0))? && !magic_at(SeekFrom::End(-8))?;
+    let ends = (magic_at(SeekFrom::Start(0))?, magic_at(SeekFrom::End(-8))?);
     file.seek(SeekFrom::Start(0))?;
-    Ok(cut)
+    Ok(ends)
 }
 
 /// The text logs being written.
@@ -210,8 +183,9 @@ impl TextSinks {
 /// The file's schemas and channels as they come, and the messages decoded by them.
 struct Decoder<'a> {
     path: &'a Path,
-    /// Schema id → its message descriptor (protobuf schemas only).
-    schemas: Vec<(u16, MessageDescriptor)>,
+    /// Protobuf schemas by id: their message's name and the file descriptor set, decoded when
+    /// an exported topic's channel names them.
+    schemas: Vec<(u16, String, Vec<u8>)>,
     /// Channel id → the exported topic it carries and its message.
     channels: Vec<(u16, &'static str, MessageDescriptor)>,
 }
@@ -232,33 +206,45 @@ impl<'a> Decoder<'a> {
         }
     }
 
-    fn message_error(&self, topic: &str, what: impl Into<String>) -> ExportError {
+    fn fault(&self, topic: &'static str, fault: MessageFault) -> ExportError {
         ExportError::Message {
             path: self.path.to_owned(),
-            topic: topic.to_owned(),
-            what: what.into(),
+            topic,
+            fault,
         }
+    }
+
+    /// Whether `topic` has a channel this export reads.
+    fn has(&self, topic: &str) -> bool {
+        self.channels.iter().any(|(_, t, _)| *t == topic)
     }
 
     fn record(&mut self, record: Record<'_>, sinks: &mut TextSinks) -> Result<(), ExportError> {
         match record {
-            Record::Schema { header, data } if header.encoding == "protobuf" => {
-                let pool = DescriptorPool::decode(data.as_ref())
-                    .map_err(|e| self.message_error(&header.name, e.to_string()))?;
-                let known = self.schemas.iter().any(|(id, _)| *id == header.id);
-                if let Some(descriptor) = pool.get_message_by_name(&header.name).filter(|_| !known)
-                {
-                    self.schemas.push((header.id, descriptor));
-                }
+            // The summary repeats the schemas and channels: the first of each counts.
+            Record::Schema { header, data }
+                if header.encoding == "protobuf"
+                    && !self.schemas.iter().any(|(id, ..)| *id == header.id) =>
+            {
+                self.schemas
+                    .push((header.id, header.name, data.into_owned()));
             }
             Record::Channel(channel) => {
                 let topic = [CAN, TELEMETRY]
                     .into_iter()
                     .find(|topic| *topic == channel.topic);
-                let schema = self.schemas.iter().find(|(id, _)| *id == channel.schema_id);
+                let schema = self
+                    .schemas
+                    .iter()
+                    .find(|(id, ..)| *id == channel.schema_id);
                 let known = self.channels.iter().any(|(id, ..)| *id == channel.id);
-                if let (Some(topic), Some((_, descriptor)), false) = (topic, schema, known) {
-                    self.channels.push((channel.id, topic, descriptor.clone()));
+                if let (Some(topic), Some((_, name, data)), false) = (topic, schema, known) {
+                    let pool = DescriptorPool::decode(data.as_slice())
+                        .map_err(|e| self.fault(topic, MessageFault::Schema(e)))?;
+                    let descriptor = pool.get_message_by_name(name).ok_or_else(|| {
+                        self.fault(topic, MessageFault::MissingMessage(name.clone()))
+                    })?;
+                    self.channels.push((channel.id, topic, descriptor));
                 }
             }
             Record::Message { header, data } => {
@@ -270,7 +256,7 @@ impl<'a> Decoder<'a> {
                     return Ok(());
                 };
                 let message = DynamicMessage::decode(descriptor.clone(), data.as_ref())
-                    .map_err(|e| self.message_error(topic, e.to_string()))?;
+                    .map_err(|e| self.fault(topic, MessageFault::Decode(e)))?;
                 if *topic == CAN {
                     for logged in self.frames(&message)? {
                         sinks.frame(&logged)?;
@@ -296,14 +282,17 @@ impl<'a> Decoder<'a> {
             .map(|value| {
                 let frame = value
                     .as_message()
-                    .ok_or_else(|| self.message_error(CAN, "a frame is not a message"))?;
+                    .ok_or_else(|| fields.fault(MessageFault::WrongType("frames")))?;
                 let id = fields.u32(frame, "id")?;
                 let data = fields.bytes(frame, "data")?;
                 let frame_of = u16::try_from(id)
                     .ok()
                     .and_then(|id| Frame::new(id, &data))
                     .ok_or_else(|| {
-                        self.message_error(CAN, format!("frame {id:#x} is not a CAN frame"))
+                        fields.fault(MessageFault::NotCanFrame {
+                            id,
+                            bytes: data.len(),
+                        })
                     })?;
                 Ok(LoggedFrame {
                     time_s: fields.f64(frame, "time_s")?,
@@ -319,17 +308,14 @@ impl<'a> Decoder<'a> {
             decoder: self,
             topic: TELEMETRY,
         };
-        let mode = fields.string(message, "mode")?;
-        let mode = match mode.as_str() {
+        let mode = match fields.string(message, "mode")?.as_str() {
             "" => None,
             label => Some(
                 ControllerMode::ALL
                     .iter()
                     .copied()
                     .find(|m| m.label() == label)
-                    .ok_or_else(|| {
-                        self.message_error(TELEMETRY, format!("unknown mode `{label}`"))
-                    })?,
+                    .ok_or_else(|| fields.fault(MessageFault::UnknownMode(label.to_owned())))?,
             ),
         };
         Ok(TelemetryRow {
@@ -353,75 +339,74 @@ struct Fields<'d, 'a> {
 }
 
 impl Fields<'_, '_> {
-    fn value(&self, message: &DynamicMessage, name: &str) -> Result<Value, ExportError> {
+    fn fault(&self, fault: MessageFault) -> ExportError {
+        self.decoder.fault(self.topic, fault)
+    }
+
+    fn value(&self, message: &DynamicMessage, name: &'static str) -> Result<Value, ExportError> {
         let descriptor = message.descriptor();
-        let field = descriptor.get_field_by_name(name).ok_or_else(|| {
-            self.decoder
-                .message_error(self.topic, format!("no field `{name}`"))
-        })?;
+        let field = descriptor
+            .get_field_by_name(name)
+            .ok_or_else(|| self.fault(MessageFault::MissingField(name)))?;
         Ok(message.get_field(&field).into_owned())
     }
 
-    fn wrong(&self, name: &str) -> ExportError {
-        self.decoder
-            .message_error(self.topic, format!("field `{name}` has another type"))
+    fn typed<T>(
+        &self,
+        message: &DynamicMessage,
+        name: &'static str,
+        read: impl FnOnce(&Value) -> Option<T>,
+    ) -> Result<T, ExportError> {
+        read(&self.value(message, name)?).ok_or_else(|| self.fault(MessageFault::WrongType(name)))
     }
 
-    fn f64(&self, message: &DynamicMessage, name: &str) -> Result<f64, ExportError> {
-        self.value(message, name)?
-            .as_f64()
-            .ok_or_else(|| self.wrong(name))
+    fn f64(&self, message: &DynamicMessage, name: &'static str) -> Result<f64, ExportError> {
+        self.typed(message, name, Value::as_f64)
     }
 
-    fn u32(&self, message: &DynamicMessage, name: &str) -> Result<u32, ExportError> {
-        self.value(message, name)?
-            .as_u32()
-            .ok_or_else(|| self.wrong(name))
+    fn u32(&self, message: &DynamicMessage, name: &'static str) -> Result<u32, ExportError> {
+        self.typed(message, name, Value::as_u32)
     }
 
-    fn bool(&self, message: &DynamicMessage, name: &str) -> Result<bool, ExportError> {
-        self.value(message, name)?
-            .as_bool()
-            .ok_or_else(|| self.wrong(name))
+    fn bool(&self, message: &DynamicMessage, name: &'static str) -> Result<bool, ExportError> {
+        self.typed(message, name, Value::as_bool)
     }
 
-    fn string(&self, message: &DynamicMessage, name: &str) -> Result<String, ExportError> {
-        self.value(message, name)?
-            .as_str()
-            .map(str::to_owned)
-            .ok_or_else(|| self.wrong(name))
+    fn string(&self, message: &DynamicMessage, name: &'static str) -> Result<String, ExportError> {
+        self.typed(message, name, |v| v.as_str().map(str::to_owned))
     }
 
-    fn bytes(&self, message: &DynamicMessage, name: &str) -> Result<Vec<u8>, ExportError> {
-        self.value(message, name)?
-            .as_bytes()
-            .map(|b| b.to_vec())
-            .ok_or_else(|| self.wrong(name))
+    fn bytes(&self, message: &DynamicMessage, name: &'static str) -> Result<Vec<u8>, ExportError> {
+        self.typed(message, name, |v| v.as_bytes().map(|b| b.to_vec()))
     }
 
-    fn list(&self, message: &DynamicMessage, name: &str) -> Result<Vec<Value>, ExportError> {
-        self.value(message, name)?
-            .as_list()
-            .map(<[Value]>::to_vec)
-            .ok_or_else(|| self.wrong(name))
+    fn list(
+        &self,
+        message: &DynamicMessage,
+        name: &'static str,
+    ) -> Result<Vec<Value>, ExportError> {
+        self.typed(message, name, |v| v.as_list().map(<[Value]>::to_vec))
     }
 
     /// A repeated double of exactly `N` values.
     fn array<const N: usize>(
         &self,
         message: &DynamicMessage,
-        name: &str,
+        name: &'static str,
     ) -> Result<[f64; N], ExportError> {
         let values = self.list(message, name)?;
-        let mut array = [0.0; N];
         if values.len() != N {
-            return Err(self.decoder.message_error(
-                self.topic,
-                format!("field `{name}` has {} values, not {N}", values.len()),
-            ));
+            return Err(self.fault(MessageFault::WrongLength {
+                field: name,
+                found: values.len(),
+                expected: N,
+            }));
         }
+        let mut array = [0.0; N];
         for (slot, value) in array.iter_mut().zip(&values) {
-            *slot = value.as_f64().ok_or_else(|| self.wrong(name))?;
+            *slot = value
+                .as_f64()
+                .ok_or_else(|| self.fault(MessageFault::WrongType(name)))?;
         }
         Ok(array)
     }
