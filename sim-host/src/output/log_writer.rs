@@ -12,7 +12,7 @@
 
 use std::fs::File;
 use std::io::BufWriter;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -78,34 +78,64 @@ impl Sinks {
         self.candump.is_none() && self.csv.is_none() && self.foxglove.is_none()
     }
 
+    /// Adds the candump log `path` (created or truncated), its lines labelled with
+    /// `interface` (so that `canplayer` can replay it there).
+    pub fn open_candump(&mut self, path: &Path, interface: &str) -> Result<(), OutputError> {
+        let io = |source| OutputError::Io {
+            path: path.to_owned(),
+            source,
+        };
+        let file = File::create(path).map_err(io)?;
+        let writer = CandumpWriter::new(BufWriter::new(file), interface).map_err(io)?;
+        self.candump = Some((path.to_owned(), writer));
+        Ok(())
+    }
+
+    /// Adds the telemetry CSV `path` (created or truncated).
+    pub fn open_csv(&mut self, path: &Path) -> Result<(), OutputError> {
+        self.csv = Some(CsvWriter::create(path)?);
+        Ok(())
+    }
+
     fn record(&mut self, record: &Record) -> Result<(), OutputError> {
         match record {
-            Record::Frame { time_s, frame } => {
-                if let Some(foxglove) = &mut self.foxglove {
-                    foxglove.frame(*time_s, frame);
-                }
-                if let Some((path, writer)) = &mut self.candump {
-                    let logged = LoggedFrame {
-                        time_s: *time_s,
-                        frame: *frame,
-                    };
-                    writer.write(&logged).map_err(|source| OutputError::Io {
-                        path: path.clone(),
-                        source,
-                    })?;
-                }
+            Record::Frame { time_s, frame } => self.frame(*time_s, frame),
+            Record::Cycle { row, sample } => self.cycle(row, sample.as_ref()),
+        }
+    }
+
+    /// Writes a frame seen on the bus at `time_s`.
+    pub fn frame(&mut self, time_s: f64, frame: &Frame) -> Result<(), OutputError> {
+        if let Some(foxglove) = &mut self.foxglove {
+            foxglove.frame(time_s, frame);
+        }
+        if let Some((path, writer)) = &mut self.candump {
+            let logged = LoggedFrame {
+                time_s,
+                frame: *frame,
+            };
+            writer.write(&logged).map_err(|source| OutputError::Io {
+                path: path.clone(),
+                source,
+            })?;
+        }
+        Ok(())
+    }
+
+    /// Writes a control cycle's telemetry `row` and, to the Foxglove log, the robot's `sample`.
+    pub fn cycle(
+        &mut self,
+        row: &TelemetryRow,
+        sample: Option<&RobotSample>,
+    ) -> Result<(), OutputError> {
+        if let Some(foxglove) = &mut self.foxglove {
+            foxglove.telemetry(row);
+            if let Some(sample) = sample {
+                foxglove.cycle(sample);
             }
-            Record::Cycle { row, sample } => {
-                if let Some(foxglove) = &mut self.foxglove {
-                    foxglove.telemetry(row);
-                    if let Some(sample) = sample {
-                        foxglove.cycle(sample);
-                    }
-                }
-                if let Some(csv) = &mut self.csv {
-                    csv.write(row)?;
-                }
-            }
+        }
+        if let Some(csv) = &mut self.csv {
+            csv.write(row)?;
         }
         Ok(())
     }

@@ -16,9 +16,7 @@ use crate::output::foxglove::{FoxgloveLog, RobotSample};
 use crate::output::log_writer::{LogWriter, Record, Sinks};
 use crate::output::output_error::OutputError;
 use crate::output::telemetry::TelemetryRow;
-use crate::output::telemetry_csv::CsvWriter;
 use crate::session::simulator::Simulator;
-use host_can::candump::CandumpWriter;
 
 pub use crate::output::log_writer::FLUSH_EVERY;
 
@@ -54,21 +52,15 @@ impl Recorder {
     /// `csv`.
     pub fn with_files(log: &Path, csv: &Path, interface: &str) -> Result<Self, OutputError> {
         let mut recorder = Self::with_candump(log, interface)?;
-        recorder.sinks_mut().csv = Some(CsvWriter::create(csv)?);
+        recorder.sinks_mut().open_csv(csv)?;
         Ok(recorder)
     }
 
     /// A recorder that also writes every frame to `path` in candump format, labelled with
     /// `interface` (so that `canplayer` can replay it there).
     pub fn with_candump(path: &Path, interface: &str) -> Result<Self, OutputError> {
-        let io = |source| OutputError::Io {
-            path: path.to_owned(),
-            source,
-        };
-        let file = std::fs::File::create(path).map_err(io)?;
-        let writer = CandumpWriter::new(std::io::BufWriter::new(file), interface).map_err(io)?;
         let mut recorder = Self::default();
-        recorder.sinks_mut().candump = Some((path.to_owned(), writer));
+        recorder.sinks_mut().open_candump(path, interface)?;
         Ok(recorder)
     }
 

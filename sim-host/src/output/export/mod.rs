@@ -7,7 +7,7 @@
 //! exported up to the cut, and the export reports the cut as an error naming how far it got.
 
 use std::fs::File;
-use std::io::{BufWriter, Read, Seek, SeekFrom};
+use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 
 use mcap::records::Record;
@@ -19,10 +19,10 @@ mod error;
 
 pub use error::{ExportError, MessageFault};
 
+use crate::output::log_writer::Sinks;
 use crate::output::output_error::OutputError;
 use crate::output::telemetry::TelemetryRow;
-use crate::output::telemetry_csv::CsvWriter;
-use host_can::candump::{CandumpWriter, LoggedFrame};
+use host_can::candump::LoggedFrame;
 
 /// Where the text logs go.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -117,41 +117,30 @@ fn magic_at_ends(file: &mut File) -> std::io::Result<(bool, bool)> {
     Ok(ends)
 }
 
-/// The text logs being written.
+/// The text logs being written (the run's own writers), and what went into them.
 struct TextSinks {
-    candump: Option<(PathBuf, CandumpWriter<BufWriter<File>>)>,
-    csv: Option<CsvWriter>,
+    sinks: Sinks,
     exported: Exported,
 }
 
 impl TextSinks {
     fn create(targets: &ExportTargets) -> Result<Self, OutputError> {
-        let candump = match &targets.candump {
-            Some((path, interface)) => {
-                let io = |source| OutputError::Io {
-                    path: path.clone(),
-                    source,
-                };
-                let file = File::create(path).map_err(io)?;
-                let writer = CandumpWriter::new(BufWriter::new(file), interface).map_err(io)?;
-                Some((path.clone(), writer))
-            }
-            None => None,
-        };
-        let csv = targets.csv.as_deref().map(CsvWriter::create).transpose()?;
+        let mut sinks = Sinks::default();
+        if let Some((path, interface)) = &targets.candump {
+            sinks.open_candump(path, interface)?;
+        }
+        if let Some(path) = &targets.csv {
+            sinks.open_csv(path)?;
+        }
         Ok(Self {
-            candump,
-            csv,
+            sinks,
             exported: Exported::default(),
         })
     }
 
     fn frame(&mut self, logged: &LoggedFrame) -> Result<(), OutputError> {
-        if let Some((path, writer)) = &mut self.candump {
-            writer.write(logged).map_err(|source| OutputError::Io {
-                path: path.clone(),
-                source,
-            })?;
+        self.sinks.frame(logged.time_s, &logged.frame)?;
+        if self.sinks.candump.is_some() {
             self.exported.frames += 1;
         }
         self.exported.last_time_s = self.exported.last_time_s.max(logged.time_s);
@@ -159,8 +148,8 @@ impl TextSinks {
     }
 
     fn row(&mut self, row: &TelemetryRow) -> Result<(), OutputError> {
-        if let Some(csv) = &mut self.csv {
-            csv.write(row)?;
+        self.sinks.cycle(row, None)?;
+        if self.sinks.csv.is_some() {
             self.exported.rows += 1;
         }
         self.exported.last_time_s = self.exported.last_time_s.max(row.time_s);
@@ -168,14 +157,7 @@ impl TextSinks {
     }
 
     fn finish(self) -> Result<Exported, OutputError> {
-        if let Some((path, writer)) = self.candump {
-            writer
-                .finish()
-                .map_err(|source| OutputError::Io { path, source })?;
-        }
-        if let Some(csv) = self.csv {
-            csv.finish()?;
-        }
+        self.sinks.finish()?;
         Ok(self.exported)
     }
 }
