@@ -35,20 +35,25 @@ struct Trial {
     calibrated: bool,
 }
 
-fn trot(seed: u64, mode: TeleopMode) -> Trial {
+/// Campaign robot `seed` (drives rated) standing still, then `mode` at [`TROT_AT_S`].
+fn stood_then(seed: u64, mode: TeleopMode) -> Rig {
     let plant = Draws::of(seed).plant(Drives::Rated.ratings());
     let plan = vec![
         PlanStep::at(0.0, TeleopMode::Stand),
         PlanStep::at(TROT_AT_S, mode),
     ];
-    let mut rig = Rig::with_plant(
+    Rig::with_plant(
         Path::new(DEFAULT_MODEL),
         plan,
         &Faults::default(),
         &Faults::default(),
         plant,
     )
-    .unwrap();
+    .unwrap()
+}
+
+fn trot(seed: u64, mode: TeleopMode) -> Trial {
+    let mut rig = stood_then(seed, mode);
     rig.run_until(TROT_AT_S).unwrap();
     let start = rig.sim().physics().torso();
     let mut fell = false;
@@ -101,19 +106,7 @@ fn check(mode: TeleopMode) {
 #[test]
 fn walk_at_no_speed_keeps_every_foot_down_once_the_bias_is_measured() {
     for seed in [100, 101, 102] {
-        let plant = Draws::of(seed).plant(Drives::Rated.ratings());
-        let plan = vec![
-            PlanStep::at(0.0, TeleopMode::Stand),
-            PlanStep::at(TROT_AT_S, TeleopMode::Walk),
-        ];
-        let mut rig = Rig::with_plant(
-            Path::new(DEFAULT_MODEL),
-            plan,
-            &Faults::default(),
-            &Faults::default(),
-            plant,
-        )
-        .unwrap();
+        let mut rig = stood_then(seed, TeleopMode::Walk);
         // A second for the legs to go from the stand to the trot's stance line.
         rig.run_until(TROT_AT_S + 1.0).unwrap();
         let controller = rig.controller().unwrap().node().controller();
