@@ -337,10 +337,15 @@ impl FoxgloveLog {
         if self.pending_can.0.is_empty() {
             return;
         }
-        let frames = std::mem::replace(&mut self.pending_can.0, Vec::with_capacity(32));
+        let message = messages::CanFrames {
+            frames: std::mem::take(&mut self.pending_can.0),
+        };
         self.channels
             .can
-            .log_with_time(&messages::CanFrames { frames }, nanos(self.pending_can.1));
+            .log_with_time(&message, nanos(self.pending_can.1));
+        // The list is kept for the next cycle's frames: no allocation a cycle.
+        self.pending_can.0 = message.frames;
+        self.pending_can.0.clear();
     }
 
     fn transforms(&self, time_s: f64, qpos: &[f64]) {
