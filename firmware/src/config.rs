@@ -5,6 +5,7 @@ use crate::control::heading::HeadingConfig;
 use crate::control::steering::SteeringConfig;
 use crate::control::stop::StopConfig;
 use crate::legs::blocked::BlockedConfig;
+use crate::legs::climb::ClimbConfig;
 use crate::legs::gait::TrotParams;
 use crate::legs::kinematics::LegGeometry;
 use crate::legs::levelling::LevellingConfig;
@@ -93,6 +94,9 @@ pub struct Config {
     pub runaway: RunawayConfig,
     /// When the trot counts as blocked by what it cannot step over.
     pub blocked: BlockedConfig,
+    /// How a backward drive stalled by a step behind climbs it ([`crate::legs::climb`];
+    /// `None`: the stall is a fault).
+    pub climb: Option<ClimbConfig>,
 }
 
 /// Per-wheel torque limit of the robot, N·m.
@@ -143,6 +147,7 @@ impl Config {
         stop: StopConfig::ROBOT,
         runaway: RunawayConfig::ROBOT,
         blocked: BlockedConfig::ROBOT,
+        climb: Some(ClimbConfig::ROBOT),
     };
 
     /// This configuration at another control rate (gains are per second, so only the tick

@@ -13,6 +13,7 @@
 
 mod blocked;
 mod carrier;
+mod climbing;
 mod folding;
 mod status;
 mod stopping;
@@ -32,6 +33,7 @@ use crate::control::sensors::Sensors;
 use crate::control::stop::Stop;
 use crate::control::teleop::Teleop;
 use crate::legs::blocked::BlockedSwings;
+use crate::legs::climb::Climb;
 use crate::legs::gait::Trot;
 use crate::legs::kinematics::LegJoints;
 use crate::legs::levelling::Levelling;
@@ -124,6 +126,10 @@ pub struct Controller {
     walk_direction: Direction,
     /// The trot's heading hold, and the yaw rate it gives the trot this tick, rad/s.
     heading: (HeadingHold, f32),
+    /// The climb under way (`State::Climbing`; `None` otherwise).
+    climb: Option<Climb>,
+    /// Whether the running fold follows a climb that set the robot on its wheels.
+    climbed: bool,
 }
 
 impl Controller {
@@ -172,6 +178,8 @@ impl Controller {
             leg_blocked: false,
             walk_direction: Direction::Forward,
             heading: (HeadingHold::default(), 0.0),
+            climb: None,
+            climbed: false,
         })
     }
 
@@ -288,6 +296,7 @@ impl Controller {
                 self.smooth(rate);
             }
             State::Folding(_) => self.fold_step(now, depth_m),
+            State::Climbing => self.climb_step(now),
             State::Wheels(_) => {
                 self.goal_rad = self.fold_rad();
                 self.smooth(self.config.fold_rate_per_s);
@@ -320,7 +329,10 @@ impl Controller {
     /// both down in a fold or stand-up), the balance law's where the wheels carry the robot, or
     /// none.
     fn wheel_torques(&mut self, now: Tick, dt_s: f32) -> [f32; 2] {
-        if self.stop.is_some_and(|stop| stop.holds_wheels()) || self.folding_on_feet() {
+        // A climb holds the wheels from its first tick: balancing, the robot rolled off the
+        // riser as the legs moved.
+        let climbing = self.climb.is_some();
+        if self.stop.is_some_and(|stop| stop.holds_wheels()) || self.folding_on_feet() || climbing {
             return self.hold_wheels(dt_s);
         }
         if !(self.balancing() && self.armed && self.wheels_may_drive()) {
@@ -378,6 +390,9 @@ impl Controller {
             // A release moves nothing by itself: the operator sends STOP, then a motion.
             self.teleop.interlock();
         }
+        if next != State::Climbing {
+            self.climb = None;
+        }
         if next != State::EStop {
             self.stop = None;
             self.release_pending = false;
@@ -397,6 +412,7 @@ impl Controller {
             self.fold_ahead_m = 0.0;
             self.fold_return = None;
             self.fold_done_at = None;
+            self.climbed = false;
         }
         let moving_on_wheels = matches!(self.state, State::Wheels(motion) if motion.moving());
         self.stopped_on_wheels = moving_on_wheels && next == State::Wheels(WheelMotion::Balance);

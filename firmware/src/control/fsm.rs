@@ -100,6 +100,8 @@ pub enum State {
     Wheels(WheelMotion),
     /// Emergency stop: drives torque-free until [`Event::EStopClear`].
     EStop,
+    /// Climbing a step behind ([`crate::legs::climb`]); a fold follows.
+    Climbing,
     /// A fault stopped the robot until [`Event::Reset`].
     Fault,
 }
@@ -145,6 +147,8 @@ impl State {
             (_, Event::EStopClear | Event::Reset) => self,
             (State::Standing(motion), Event::PoseReached) => State::Legs(motion),
             (State::Folding(motion), Event::PoseReached) => State::Wheels(motion),
+            (State::Climbing, Event::PoseReached) => State::Folding(WheelMotion::Balance),
+            (State::Climbing, _) => State::Climbing,
             (_, Event::PoseReached) => self,
             (_, Event::TeleopLost | Event::LinkDegraded | Event::LegBlocked) => {
                 self.on_request(TeleopMode::Stop)
@@ -201,7 +205,7 @@ impl State {
             }
             State::Legs(LegMotion::Trot(Direction::Forward)) => ControllerMode::TrotForward,
             State::Legs(LegMotion::Trot(Direction::Backward)) => ControllerMode::TrotBackward,
-            State::Standing(_) => ControllerMode::Standing,
+            State::Standing(_) | State::Climbing => ControllerMode::Standing,
             State::Folding(_) => ControllerMode::Folding,
             State::Wheels(WheelMotion::Drive(Direction::Forward)) => ControllerMode::WheelForward,
             State::Wheels(WheelMotion::Drive(Direction::Backward)) => ControllerMode::WheelBackward,
@@ -217,7 +221,7 @@ impl State {
     pub fn balancing(self) -> bool {
         matches!(
             self,
-            State::Folding(_) | State::Wheels(_) | State::Standing(_)
+            State::Folding(_) | State::Wheels(_) | State::Standing(_) | State::Climbing
         )
     }
 }

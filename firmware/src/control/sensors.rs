@@ -15,6 +15,8 @@ pub struct Sensors {
     pub joint_position_rad: Joints<f32>,
     /// Joint velocities, rad/s.
     pub joint_velocity_rad_s: Joints<f32>,
+    /// Joint torques the drives report, N·m (what a climb weighs its feet's loads with).
+    pub joint_effort_nm: Joints<f32>,
     /// Wheel joint rates (left, right), relative to the body, rad/s.
     pub wheel_rate_rad_s: [f32; 2],
     /// Torso attitude (the estimator's; level before the first IMU sample).
@@ -37,6 +39,7 @@ impl Sensors {
         Self {
             joint_position_rad: Joints::splat(0.0),
             joint_velocity_rad_s: Joints::splat(0.0),
+            joint_effort_nm: Joints::splat(0.0),
             wheel_rate_rad_s: [0.0; 2],
             attitude: Attitude {
                 pitch_rad: 0.0,
@@ -55,6 +58,7 @@ impl Sensors {
     pub fn record_leg(&mut self, now: Tick, leg: Leg, feedback: &LegFeedback) {
         *self.joint_position_rad.leg_mut(leg) = feedback.position.map(|p| p.si());
         *self.joint_velocity_rad_s.leg_mut(leg) = feedback.velocity.map(|v| v.si());
+        *self.joint_effort_nm.leg_mut(leg) = feedback.effort.map(|e| e.si());
         if let Some(watchdog) = self.legs.get_mut(leg_index(leg)) {
             watchdog.feed(now);
         }

@@ -6,6 +6,7 @@
 //! feet carry the robot).
 
 pub mod blocked;
+pub mod climb;
 pub mod crawl;
 pub mod foot_trajectory;
 pub mod gait;

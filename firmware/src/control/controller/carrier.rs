@@ -99,6 +99,7 @@ impl Controller {
     /// until the legs' stance has been computed.
     pub(super) fn wheels_carry(&self) -> bool {
         matches!(self.state, State::Wheels(_))
+            || (self.climbed && matches!(self.state, State::Folding(_)))
             || self
                 .leg_stance
                 .is_some_and(|stance| self.config.support.grounds_wheels(&stance))

@@ -37,7 +37,10 @@ impl Controller {
                 torque_limit_nm: self.config.balance.torque_limit_nm,
             };
             if let Some(cause) = self.runaway.update(&self.config.runaway, &input) {
-                self.wheel_fault_stop(now, cause, input.ground_speed_m_s);
+                let climbs = cause == protocol::FaultFlags::WHEEL_STALL && self.climb_on_stall(now);
+                if !climbs {
+                    self.wheel_fault_stop(now, cause, input.ground_speed_m_s);
+                }
             }
         }
         self.turn_ref_rad_s = crate::math::toward(

@@ -1,0 +1,89 @@
+//! The climb of a step behind ([`crate::legs::climb`]): started where a backward drive
+//! stalls against a riser, the feet placed by their drives' loads, then a fold onto the
+//! wheels over the plateau.
+
+use protocol::Leg;
+
+use super::Controller;
+use crate::control::fsm::{Direction, Event, State, WheelMotion};
+use crate::legs::climb::{solve, Climb, ClimbEnd, Phase};
+use crate::legs::crawl::foot_loads_n;
+use crate::legs::crawl::frame::PerLeg;
+use crate::legs::kinematics::{leg_fk, LegJoints};
+use crate::time::Tick;
+
+impl Controller {
+    /// A stall on the wheels at `now`: driving backward with a climb configured, the climb
+    /// starts (`true`); otherwise the caller faults.
+    pub(super) fn climb_on_stall(&mut self, now: Tick) -> bool {
+        let backward = self.state == State::Wheels(WheelMotion::Drive(Direction::Backward));
+        if !backward || self.config.climb.is_none() {
+            return false;
+        }
+        let measured =
+            PerLeg::from_fn(|leg| LegJoints::from_array(*self.sensors.joint_position_rad.leg(leg)));
+        self.climb = Some(Climb::new(now, &self.config.geometry, &measured));
+        self.balance.rebase(0.0);
+        self.balance.hold_here();
+        self.state = State::Climbing;
+        true
+    }
+
+    /// The climb under way, if any.
+    pub fn climb(&self) -> Option<&Climb> {
+        self.climb.as_ref()
+    }
+
+    /// This tick of the climb: the legs' goal, and the trot while it walks.
+    pub(super) fn climb_step(&mut self, now: Tick) {
+        let (Some(mut climb), Some(config)) = (self.climb, self.config.climb) else {
+            self.apply(Event::PoseReached);
+            return;
+        };
+        let loads = foot_loads_n(
+            &self.config.geometry,
+            &self.sensors.joint_position_rad,
+            &self.sensors.joint_effort_nm,
+        );
+        climb.tick(
+            &config,
+            self.config.rate,
+            now,
+            &loads,
+            self.sensors.attitude.pitch_rad,
+        );
+        self.climb = Some(climb);
+        match climb.phase() {
+            Phase::Ended(end) => {
+                if end != ClimbEnd::Over {
+                    self.leg_blocked = true;
+                }
+                self.climb = None;
+                self.apply(Event::PoseReached);
+                self.climbed = end == ClimbEnd::Over;
+            }
+            _ => {
+                self.climb_pose(&climb);
+                self.smooth(self.config.leg_rate_per_s);
+            }
+        }
+    }
+
+    /// The goal from the climb's foot targets.
+    fn climb_pose(&mut self, climb: &Climb) {
+        let targets = climb.targets();
+        for leg in Leg::ALL {
+            let goal = LegJoints::from_array(*self.goal_rad.leg(leg));
+            let pitch_rad = leg_fk(&self.config.geometry, &goal).pitch_rad;
+            match solve(
+                &self.config.geometry,
+                &self.config.limits,
+                targets.get(leg),
+                pitch_rad,
+            ) {
+                Some(joints) => *self.goal_rad.leg_mut(leg) = joints.to_array(),
+                None => self.ik_failures = self.ik_failures.saturating_add(1),
+            }
+        }
+    }
+}

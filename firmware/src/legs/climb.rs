@@ -1,0 +1,450 @@
+//! The wheels-first climb of a step behind the robot: it backs onto the step on its wheels,
+//! and where the wheels stall against the riser the back hips already stand over the
+//! plateau. The legs' knees bend so that a foot reaches high only behind its hip
+//! ([`crate::legs::kinematics`]), so the back feet can be set on the plateau from there with
+//! the robot still on its wheels — no foot has to step up a riser.
+//!
+//! The climb, one phase after another, every foot placed by its leg's own measured load:
+//!
+//! 1. **Prop**: the wheels hold still and the front feet are lowered from the fold onto the
+//!    ground before the riser until each carries a load: the robot stands on wheels and front
+//!    feet, a stool.
+//! 2. **Reach**: the back feet swing from the fold to above the plateau, behind their hips.
+//! 3. **Probe**: they are lowered until each carries a load.
+//! 4. **Rise**: the legs lengthen, lifting the wheels clear of the plateau, each pair to its
+//!    own depth below the hips.
+//! 5. **Crawl**: the body shifts back over its four planted feet, then each foot steps back
+//!    in turn; the stance is long (back feet well behind their hips on the plateau, front feet
+//!    under theirs), so that the centre of mass stays inside the other three feet without a
+//!    sway. A few cycles carry the wheels over the plateau.
+//! 6. Then the robot folds onto its wheels there (the controller's fold).
+//!
+//! A step lower than the wheels climb, higher than the legs set a foot on, or no ground
+//! within reach ends the climb with a [`ClimbEnd`] the controller reports.
+
+use protocol::Leg;
+
+use crate::legs::crawl::frame::PerLeg;
+use crate::legs::kinematics::{leg_fk, leg_ik, FootTarget, KneeBranch, LegGeometry, LegJoints};
+use crate::limits::JointLimits;
+use crate::math::{clamp, deg_to_rad};
+use crate::time::{Tick, TickRate};
+
+/// How the climb places the feet and how far it walks.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClimbConfig {
+    /// Where the back feet go above the plateau: behind their hips, m.
+    pub reach_x_m: f32,
+    /// … and below their hips, m (above a step as high as the legs set a foot on).
+    pub reach_depth_m: f32,
+    /// How long the swings to above the ground take, ms.
+    pub reach_ms: u32,
+    /// Where the front feet go down: behind their hips, m.
+    pub prop_x_m: f32,
+    /// … starting this far below their hips, m.
+    pub prop_depth_m: f32,
+    /// How fast a foot is lowered toward the ground, m/s.
+    pub probe_m_s: f32,
+    /// Deepest a foot is lowered looking for ground, m below its hip.
+    pub probe_depth_max_m: f32,
+    /// A foot carrying this much is down, N.
+    pub touchdown_n: f32,
+    /// How much deeper than where it touched a foot is then held, m (its share of the weight).
+    pub preload_m: f32,
+    /// Half the distance between the front and back hips, m (the body's pitch moves each pair
+    /// up or down by it).
+    pub hip_half_span_m: f32,
+    /// Where the front feet stand after the rise, m below their hips.
+    pub front_depth_m: f32,
+    /// Where the back feet stand after the rise, m below their hips: as deep as the legs
+    /// still swing a foot from (a foot under its hip reaches no higher than 0.29 m below it),
+    /// the body pitched nose down by what the step is higher than the two depths differ.
+    pub back_depth_m: f32,
+    /// How far each crawl cycle carries the body back, m.
+    pub crawl_m: f32,
+    /// How many crawl cycles carry the wheels over the plateau.
+    pub crawl_cycles: u8,
+    /// How long the body's shift over the planted feet takes, ms.
+    pub shift_ms: u32,
+    /// How long one foot's step takes (lift, carry, lower), ms.
+    pub step_ms: u32,
+    /// How high a stepping foot lifts, m.
+    pub lift_m: f32,
+    /// How long the lift, and the last lowering onto the wheels, take, ms.
+    pub rise_ms: u32,
+    /// How much the back legs shorten at the end, m: the body tips back about the front
+    /// feet until the wheels stand on the plateau.
+    pub lower_m: f32,
+    /// Steps lower than this (m) the wheels roll: no climb.
+    pub step_min_m: f32,
+    /// Steps higher than this (m) are not climbed.
+    pub step_max_m: f32,
+}
+
+impl ClimbConfig {
+    /// The robot.
+    pub const ROBOT: Self = Self {
+        reach_x_m: -0.20,
+        reach_depth_m: 0.12,
+        reach_ms: 800,
+        prop_x_m: -0.06,
+        prop_depth_m: 0.18,
+        probe_m_s: 0.06,
+        probe_depth_max_m: 0.31,
+        touchdown_n: 25.0,
+        preload_m: 0.01,
+        hip_half_span_m: 0.22,
+        front_depth_m: 0.36,
+        back_depth_m: 0.31,
+        crawl_m: 0.09,
+        crawl_cycles: 2,
+        shift_ms: 1200,
+        step_ms: 1200,
+        lift_m: 0.03,
+        rise_ms: 2000,
+        lower_m: 0.14,
+        step_min_m: 0.03,
+        step_max_m: 0.11,
+    };
+}
+
+/// Why a climb ended.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ClimbEnd {
+    /// The legs stand on both levels and the trot has carried the wheels over the plateau:
+    /// fold onto them.
+    Over,
+    /// No ground within the legs' reach.
+    NoGround,
+    /// The step is lower than the wheels climb (no climb needed) or higher than the legs set
+    /// a foot on.
+    StepOutOfRange,
+}
+
+/// Where the climb is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Phase {
+    /// Front feet swinging down and lowered until they carry.
+    Prop,
+    /// Back feet swinging from the fold to above the plateau.
+    Reach,
+    /// Back feet lowered until they carry.
+    Probe,
+    /// The legs lengthening.
+    Rise,
+    /// Crawl cycle `cycle`: the body shifting back over the planted feet.
+    Shift {
+        /// Cycles done before this one.
+        cycle: u8,
+    },
+    /// Crawl cycle `cycle`: the `foot`-th foot (back feet first) stepping back.
+    Step {
+        /// Cycles done before this one.
+        cycle: u8,
+        /// Which foot of [`STEP_ORDER`].
+        foot: u8,
+    },
+    /// The back legs shortening until the wheels stand on the plateau.
+    Lower,
+    /// Over, or given up.
+    Ended(ClimbEnd),
+}
+
+/// A foot's place in its leg frame: forward and below the hip, m.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Foot {
+    /// Forward of the hip, m.
+    pub x_m: f32,
+    /// Below the hip, m.
+    pub depth_m: f32,
+}
+
+/// The climb under way.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Climb {
+    phase: Phase,
+    since: Tick,
+    /// Where each foot started this phase.
+    from: PerLeg<Foot>,
+    /// Each foot's target now.
+    target: PerLeg<Foot>,
+    /// Which feet are down.
+    down: PerLeg<bool>,
+}
+
+impl Climb {
+    /// A climb starting at `now` with the legs at `measured` (the fold).
+    pub fn new(now: Tick, geometry: &LegGeometry, measured: &PerLeg<LegJoints>) -> Self {
+        let feet = PerLeg::from_fn(|leg| foot_of(geometry, &measured.get(leg)));
+        Self {
+            phase: Phase::Prop,
+            since: now,
+            from: feet,
+            target: feet,
+            down: PerLeg::splat(false),
+        }
+    }
+
+    /// The phase.
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
+    /// Each foot's target now.
+    pub fn targets(&self) -> PerLeg<Foot> {
+        self.target
+    }
+
+    /// The step's height from where the feet touched and the body's pitch then (positive nose
+    /// down), m: the back feet's height over the front feet's.
+    pub fn step_height_m(&self, config: &ClimbConfig, pitch_rad: f32) -> f32 {
+        let mean = |a: Leg, b: Leg| 0.5 * (self.target.get(a).depth_m + self.target.get(b).depth_m);
+        mean(Leg::Fl, Leg::Fr) - mean(Leg::Bl, Leg::Br)
+            + 2.0 * config.hip_half_span_m * crate::math::sin(pitch_rad)
+    }
+
+    /// One tick at `now`: `loads_n` is each foot's load from its drives (`None`: not known).
+    pub fn tick(
+        &mut self,
+        config: &ClimbConfig,
+        rate: TickRate,
+        now: Tick,
+        loads_n: &PerLeg<Option<f32>>,
+        pitch_rad: f32,
+    ) {
+        let t_s = now.since(self.since) as f32 * rate.period_s();
+        match self.phase {
+            Phase::Prop => self.prop(config, rate, now, t_s, loads_n),
+            Phase::Reach => self.reach(config, now, t_s),
+            Phase::Probe => self.probe(config, rate, now, loads_n, pitch_rad),
+            Phase::Rise => self.rise(config, now, t_s),
+            Phase::Shift { cycle } => self.shift(config, now, t_s, cycle),
+            Phase::Step { cycle, foot } => self.step(config, now, t_s, cycle, foot),
+            Phase::Lower => self.lower_onto_wheels(config, t_s),
+            Phase::Ended(_) => {}
+        }
+    }
+
+    fn prop(
+        &mut self,
+        config: &ClimbConfig,
+        rate: TickRate,
+        now: Tick,
+        t_s: f32,
+        loads_n: &PerLeg<Option<f32>>,
+    ) {
+        let share = t_s / (config.reach_ms as f32 * 1e-3);
+        let goal = Foot {
+            x_m: config.prop_x_m,
+            depth_m: config.prop_depth_m,
+        };
+        if share < 1.0 && !self.down.fl && !self.down.fr {
+            for leg in [Leg::Fl, Leg::Fr] {
+                *self.target.get_mut(leg) = blend(self.from.get(leg), goal, share);
+            }
+        }
+        if self.lower([Leg::Fl, Leg::Fr], config, rate, loads_n) {
+            self.enter(Phase::Reach, now);
+        }
+    }
+
+    fn reach(&mut self, config: &ClimbConfig, now: Tick, t_s: f32) {
+        let share = t_s / (config.reach_ms as f32 * 1e-3);
+        let goal = Foot {
+            x_m: config.reach_x_m,
+            depth_m: config.reach_depth_m,
+        };
+        for leg in [Leg::Bl, Leg::Br] {
+            *self.target.get_mut(leg) = blend(self.from.get(leg), goal, share);
+        }
+        if share >= 1.0 {
+            self.enter(Phase::Probe, now);
+        }
+    }
+
+    fn probe(
+        &mut self,
+        config: &ClimbConfig,
+        rate: TickRate,
+        now: Tick,
+        loads_n: &PerLeg<Option<f32>>,
+        pitch_rad: f32,
+    ) {
+        if self.lower([Leg::Bl, Leg::Br], config, rate, loads_n) {
+            let step_m = self.step_height_m(config, pitch_rad);
+            if !(config.step_min_m..=config.step_max_m).contains(&step_m) {
+                self.phase = Phase::Ended(ClimbEnd::StepOutOfRange);
+            } else {
+                self.enter(Phase::Rise, now);
+            }
+        }
+    }
+
+    fn rise(&mut self, config: &ClimbConfig, now: Tick, t_s: f32) {
+        let share = clamp(t_s / (config.rise_ms as f32 * 1e-3), 0.0, 1.0);
+        let s = smoothstep(share);
+        for leg in Leg::ALL {
+            let from = self.from.get(leg);
+            let depth_m = match leg {
+                Leg::Fl | Leg::Fr => config.front_depth_m,
+                Leg::Bl | Leg::Br => config.back_depth_m,
+            };
+            *self.target.get_mut(leg) = Foot {
+                depth_m: from.depth_m + (depth_m - from.depth_m) * s,
+                ..from
+            };
+        }
+        if share >= 1.0 {
+            self.enter(Phase::Shift { cycle: 0 }, now);
+        }
+    }
+
+    fn shift(&mut self, config: &ClimbConfig, now: Tick, t_s: f32, cycle: u8) {
+        let share = clamp(t_s / (config.shift_ms as f32 * 1e-3), 0.0, 1.0);
+        for leg in Leg::ALL {
+            let from = self.from.get(leg);
+            *self.target.get_mut(leg) = Foot {
+                x_m: from.x_m + config.crawl_m * smoothstep(share),
+                ..from
+            };
+        }
+        if share >= 1.0 {
+            if cycle + 1 >= config.crawl_cycles {
+                self.enter(Phase::Lower, now);
+            } else {
+                self.enter(Phase::Step { cycle, foot: 0 }, now);
+            }
+        }
+    }
+
+    fn step(&mut self, config: &ClimbConfig, now: Tick, t_s: f32, cycle: u8, foot: u8) {
+        let Some(&leg) = STEP_ORDER.get(usize::from(foot)) else {
+            self.phase = Phase::Ended(ClimbEnd::Over);
+            return;
+        };
+        let share = clamp(t_s / (config.step_ms as f32 * 1e-3), 0.0, 1.0);
+        *self.target.get_mut(leg) = step_foot(self.from.get(leg), config, share);
+        if share >= 1.0 {
+            let next = if usize::from(foot) + 1 < STEP_ORDER.len() {
+                Phase::Step {
+                    cycle,
+                    foot: foot + 1,
+                }
+            } else {
+                Phase::Shift { cycle: cycle + 1 }
+            };
+            self.enter(next, now);
+        }
+    }
+
+    fn lower_onto_wheels(&mut self, config: &ClimbConfig, t_s: f32) {
+        let share = clamp(t_s / (config.rise_ms as f32 * 1e-3), 0.0, 1.0);
+        for leg in [Leg::Bl, Leg::Br] {
+            let from = self.from.get(leg);
+            *self.target.get_mut(leg) = Foot {
+                depth_m: from.depth_m - config.lower_m * smoothstep(share),
+                ..from
+            };
+        }
+        if share >= 1.0 {
+            self.phase = Phase::Ended(ClimbEnd::Over);
+        }
+    }
+
+    /// Lowers `legs`' feet not yet down by this tick's share of the probe speed, and marks
+    /// those that carry; `true` once all are down. A foot past the deepest probe ends the
+    /// climb ([`ClimbEnd::NoGround`]).
+    fn lower(
+        &mut self,
+        legs: [Leg; 2],
+        config: &ClimbConfig,
+        rate: TickRate,
+        loads_n: &PerLeg<Option<f32>>,
+    ) -> bool {
+        let step_m = config.probe_m_s * rate.period_s();
+        for leg in legs {
+            if self.down.get(leg) {
+                continue;
+            }
+            let carries = loads_n.get(leg).is_some_and(|n| n >= config.touchdown_n);
+            let foot = self.target.get_mut(leg);
+            if carries {
+                foot.depth_m += config.preload_m;
+                *self.down.get_mut(leg) = true;
+            } else if foot.depth_m + step_m > config.probe_depth_max_m {
+                self.phase = Phase::Ended(ClimbEnd::NoGround);
+                return false;
+            } else {
+                foot.depth_m += step_m;
+            }
+        }
+        legs.iter().all(|&leg| self.down.get(leg))
+    }
+
+    fn enter(&mut self, phase: Phase, now: Tick) {
+        self.phase = phase;
+        self.since = now;
+        self.from = self.target;
+    }
+}
+
+/// Where `joints` put the foot in its leg's sagittal plane.
+pub fn foot_of(geometry: &LegGeometry, joints: &LegJoints) -> Foot {
+    let foot = leg_fk(geometry, joints);
+    Foot {
+        x_m: foot.x_m,
+        depth_m: -foot.z_m,
+    }
+}
+
+/// Joint angles that put the foot at `foot`, with the foot pitch nearest `pitch_rad` that the
+/// joints reach (tried in 5° steps to either side, up to 90°).
+pub fn solve(
+    geometry: &LegGeometry,
+    limits: &JointLimits,
+    foot: Foot,
+    pitch_rad: f32,
+) -> Option<LegJoints> {
+    const STEPS: i32 = 18;
+    let step_rad = deg_to_rad(5.0);
+    (0..=2 * STEPS).find_map(|i: i32| {
+        let offset: i32 = if i % 2_i32 == 0_i32 {
+            i / 2_i32
+        } else {
+            -(i + 1_i32) / 2_i32
+        };
+        let target = FootTarget {
+            x_m: foot.x_m,
+            y_m: 0.0,
+            z_m: -foot.depth_m,
+            pitch_rad: pitch_rad + offset as f32 * step_rad,
+        };
+        leg_ik(geometry, limits, &target, KneeBranch::Down).ok()
+    })
+}
+
+/// The order the feet step in within a crawl cycle: the back feet first, onto the plateau.
+const STEP_ORDER: [Leg; 2] = [Leg::Bl, Leg::Br];
+
+/// A foot stepping `config.crawl_m` back from `from`, `share` of the way through: lifted in
+/// the first third, carried in the second, set down at its depth again in the last.
+fn step_foot(from: Foot, config: &ClimbConfig, share: f32) -> Foot {
+    let third = |k: f32| clamp(3.0 * share - k, 0.0, 1.0);
+    let lift_m = config.lift_m * (smoothstep(third(0.0)) - smoothstep(third(2.0)));
+    Foot {
+        x_m: from.x_m - config.crawl_m * smoothstep(third(1.0)),
+        depth_m: from.depth_m - lift_m,
+    }
+}
+
+fn blend(from: Foot, to: Foot, share: f32) -> Foot {
+    let s = smoothstep(clamp(share, 0.0, 1.0));
+    Foot {
+        x_m: from.x_m + (to.x_m - from.x_m) * s,
+        depth_m: from.depth_m + (to.depth_m - from.depth_m) * s,
+    }
+}
+
+fn smoothstep(s: f32) -> f32 {
+    s * s * (3.0 - 2.0 * s)
+}
