@@ -20,14 +20,22 @@ use teleop_core::scripted::PlanStep;
 
 /// The step's height, m.
 const STEP_M: f64 = 0.06;
+/// How deep the plateau is, m: room to drive on after the climb.
+const PLATEAU_M: f64 = 6.0;
+/// When the operator stops the drive, s (every climb has ended by then).
+const STOP_S: f64 = 25.0;
+
 /// Height of the torso's origin over the ground balancing on the wheels, m.
 const ON_WHEELS_M: f64 = 0.27;
 
 /// What one trial did.
 #[derive(Debug)]
 struct Figures {
-    /// Whether the robot fell (tilt past 45° or the torso on the ground).
-    fell: bool,
+    /// When it first fell (tilt past 45° or the torso on the ground), s, and the controller's
+    /// state then.
+    fell_at: Option<(f64, Option<State>)>,
+    /// The controller's states in order, with when each began, s.
+    states: Vec<(f64, State)>,
     /// The state at the end.
     state: Option<State>,
     /// How far past the riser the axle ended, onto the plateau, m.
@@ -38,13 +46,26 @@ struct Figures {
     max_tilt_deg: f64,
 }
 
+impl Figures {
+    /// From the start of the climb to the wheels carrying the robot again, s.
+    fn climb_s(&self) -> Option<f64> {
+        let start = self.states.iter().find(|(_, s)| *s == State::Climbing)?.0;
+        let end = self
+            .states
+            .iter()
+            .find(|&&(t, s)| t > start && matches!(s, State::Wheels(_)))?
+            .0;
+        Some(end - start)
+    }
+}
+
 /// Backs robot `seed` into a 6 cm riser `distance_m` behind it and runs for `end_s`.
 fn climb(seed: u64, distance_m: f64, end_s: f64) -> Figures {
     let riser_x_m = -distance_m;
     let scene = Scene::Step(Step {
         height_m: STEP_M,
-        riser_x_m: riser_x_m - 1.2,
-        depth_m: 1.2,
+        riser_x_m: riser_x_m - PLATEAU_M,
+        depth_m: PLATEAU_M,
     });
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("climb")
@@ -53,22 +74,32 @@ fn climb(seed: u64, distance_m: f64, end_s: f64) -> Figures {
     let plan = vec![
         PlanStep::at(0.0, TeleopMode::Fold),
         PlanStep::at(4.0, TeleopMode::WheelBackward),
+        PlanStep::at(STOP_S, TeleopMode::Stop),
     ];
     let faults = Faults::default();
     let plant = Draws::of(seed).plant(Drives::Rated.ratings());
     let mut rig = Rig::with_plant(&model, plan, &faults, &faults, plant).unwrap();
-    let (mut fell, mut max_tilt_deg) = (false, 0.0_f64);
+    let mut max_tilt_deg = 0.0_f64;
+    let (mut fell_at, mut states) = (None, Vec::new());
     while rig.time_s() < end_s {
         rig.step().unwrap();
         let record = rig.records().last().unwrap();
-        fell |= record.fallen();
+        if record.fallen() && fell_at.is_none() {
+            fell_at = Some((rig.time_s(), record.state));
+        }
+        if let Some(state) = record.state {
+            if states.last().is_none_or(|&(_, last)| last != state) {
+                states.push((rig.time_s(), state));
+            }
+        }
         if rig.time_s() > 4.0 {
             max_tilt_deg = max_tilt_deg.max(record.tilt_deg);
         }
     }
     let torso = rig.sim().physics().torso();
     Figures {
-        fell,
+        fell_at,
+        states,
         state: rig.records().last().unwrap().state,
         onto_plateau_m: riser_x_m - torso.pos_m[0],
         torso_z_m: torso.pos_m[2],
@@ -76,16 +107,26 @@ fn climb(seed: u64, distance_m: f64, end_s: f64) -> Figures {
     }
 }
 
+/// The longest a crossing may take from the stall to the wheels on the plateau, s (the
+/// issue's figure).
+const MAX_CLIMB_S: f64 = 20.0;
+
+/// The largest tilt a crossing of a 6 cm step may show, degrees (the pitch figure).
+const MAX_TILT_DEG: f64 = 25.0;
+
 /// Whether `f` is a crossing: balancing on the wheels on the plateau (the torso a step's
-/// height above where it rides on flat ground, the axle past the riser), never fallen.
+/// height above where it rides on flat ground, the axle past the riser), never fallen nor
+/// tilted past [`MAX_TILT_DEG`].
 fn crossed(f: &Figures) -> bool {
-    !f.fell
+    f.fell_at.is_none()
+        && f.climb_s().is_some_and(|s| s <= MAX_CLIMB_S)
+        && f.max_tilt_deg <= MAX_TILT_DEG
         && f.state == Some(State::Wheels(WheelMotion::Balance))
         && f.torso_z_m > ON_WHEELS_M + STEP_M - 0.01
         && f.onto_plateau_m > 0.05
 }
 
-/// Seeded trials, the riser 1–2 m behind: at least 20 of 24 robots cross (measured: see
+/// Seeded trials, the riser 1–2 m behind: at least 22 of 24 robots cross (measured: see
 /// docs/obstacles.md).
 #[test]
 fn backing_into_a_6cm_step_the_robot_climbs_it_and_balances_on_the_plateau() {
@@ -93,11 +134,14 @@ fn backing_into_a_6cm_step_the_robot_climbs_it_and_balances_on_the_plateau() {
     let mut crossings = 0;
     for seed in 0..TRIALS {
         let distance_m = 1.0 + 1.0 * Draw::new(seed ^ 0xc11b_0000).unit();
-        let f = climb(seed, distance_m, 35.0);
+        let f = climb(seed, distance_m, STOP_S + 4.0);
         let ok = crossed(&f);
         crossings += u64::from(ok);
-        println!("MEASURED seed {seed}, riser {distance_m:.2} m behind, crossed {ok}: {f:?}");
+        println!(
+            "MEASURED seed {seed}, riser {distance_m:.2} m behind, crossed {ok}, climb {:?} s: {f:?}",
+            f.climb_s()
+        );
     }
     println!("MEASURED {crossings} of {TRIALS} crossed");
-    assert!(crossings >= 20, "{crossings} of {TRIALS} crossed");
+    assert!(crossings >= 22, "{crossings} of {TRIALS} crossed");
 }

@@ -18,6 +18,7 @@
 //! | `Standing(_)`      | Standing(Stand)                                      | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Legs(m)       |
 //! | `Folding(_)`       | Folding(Balance)                                     | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Wheels(m)     |
 //! | `Wheels(_)`        | Wheels(Balance)                                      | Standing(Stand)| Standing(Trot d)  | —                | Wheels(w)         | —             |
+//! | `Climbing`         | —                                                    | —              | —                 | —                | —                 | Folding(Balance) |
 //! | `EStop`            | —                                                    | —              | —                 | —                | —                 | —             |
 //! | `Fault`            | —                                                    | —              | —                 | —                | —                 | —             |
 //!
@@ -32,6 +33,11 @@
 //! | `EStopClear`  | `EStop` → `Hold`; no effect elsewhere. The controller applies a release once its controlled stop has ended, and then raises `Fault` if a drive's fault or a frozen SYNC remains |
 //! | `Fault`       | `Fault` from any state but `EStop` (an E-stop outranks a fault)            |
 //! | `Reset`       | `Fault` → `Hold` (sent when the operator asks to stop and no cause remains); no effect elsewhere |
+//!
+//! `Climbing` is entered by the controller itself, not by a request: a backward drive whose
+//! wheels stall against a step climbs it ([`crate::legs::climb`]), and its end (on the
+//! plateau, or given up) is its `PoseReached`. Requests wait for that end; an E-stop or a
+//! fault does not.
 //!
 //! `Hold` is where the robot starts and where it returns after a clear or a reset: the drives
 //! hold their present positions and nothing moves until the operator asks for a motion.

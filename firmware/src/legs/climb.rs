@@ -72,9 +72,11 @@ pub struct ClimbConfig {
     pub lift_m: f32,
     /// How long the lift, and the last lowering onto the wheels, take, ms.
     pub rise_ms: u32,
-    /// How much the back legs shorten at the end, m: the body tips back about the front
-    /// feet until the wheels stand on the plateau.
-    pub lower_m: f32,
+    /// How much the back legs shorten at the end, m, …
+    pub lower_back_m: f32,
+    /// … and the front legs (they stand ahead of their hips there, near their reach), m: the
+    /// body comes down and tips back until the wheels stand on the plateau.
+    pub lower_front_m: f32,
     /// Steps lower than this (m) the wheels roll: no climb.
     pub step_min_m: f32,
     /// Steps higher than this (m) are not climbed.
@@ -102,7 +104,8 @@ impl ClimbConfig {
         step_ms: 1200,
         lift_m: 0.03,
         rise_ms: 2000,
-        lower_m: 0.14,
+        lower_back_m: 0.10,
+        lower_front_m: 0.045,
         step_min_m: 0.03,
         step_max_m: 0.11,
     };
@@ -339,10 +342,14 @@ impl Climb {
 
     fn lower_onto_wheels(&mut self, config: &ClimbConfig, t_s: f32) {
         let share = clamp(t_s / (config.rise_ms as f32 * 1e-3), 0.0, 1.0);
-        for leg in [Leg::Bl, Leg::Br] {
+        for leg in Leg::ALL {
             let from = self.from.get(leg);
+            let lower_m = match leg {
+                Leg::Fl | Leg::Fr => config.lower_front_m,
+                Leg::Bl | Leg::Br => config.lower_back_m,
+            };
             *self.target.get_mut(leg) = Foot {
-                depth_m: from.depth_m - config.lower_m * smoothstep(share),
+                depth_m: from.depth_m - lower_m * smoothstep(share),
                 ..from
             };
         }

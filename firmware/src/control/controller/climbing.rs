@@ -60,7 +60,13 @@ impl Controller {
                 }
                 self.climb = None;
                 self.apply(Event::PoseReached);
-                self.climbed = end == ClimbEnd::Over;
+                if end == ClimbEnd::Over {
+                    // Over the step: the fold onto the wheels, then on backward as the operator
+                    // asked. A climb given up folds and balances (backing on would meet the
+                    // same riser).
+                    self.climbed = true;
+                    self.apply(Event::Request(protocol::TeleopMode::WheelBackward));
+                }
             }
             _ => {
                 self.climb_pose(&climb);
