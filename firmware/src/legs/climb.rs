@@ -13,11 +13,13 @@
 //! 3. **Probe**: they are lowered until each carries a load.
 //! 4. **Rise**: the legs lengthen, lifting the wheels clear of the plateau, each pair to its
 //!    own depth below the hips.
-//! 5. **Crawl**: the body shifts back over its four planted feet, then each foot steps back
-//!    in turn; the stance is long (back feet well behind their hips on the plateau, front feet
-//!    under theirs), so that the centre of mass stays inside the other three feet without a
-//!    sway. A few cycles carry the wheels over the plateau.
-//! 6. Then the robot folds onto its wheels there (the controller's fold).
+//! 5. **Crawl**: the body shifts back over its four planted feet, each back foot steps back,
+//!    and the body shifts back again; the stance is long (back feet well behind their hips on
+//!    the plateau), so that the centre of mass stays inside the other three feet without a
+//!    sway. The front feet do not step: each front step let the body slide forward as far as
+//!    the shift had carried it back.
+//! 6. **Lower**: all four legs shorten, the back pair more, until the wheels stand on the
+//!    plateau; then the robot folds onto them there (the controller's fold).
 //!
 //! A step lower than the wheels climb, higher than the legs set a foot on, or no ground
 //! within reach ends the climb with a [`ClimbEnd`] the controller reports.
@@ -30,7 +32,7 @@ use crate::limits::JointLimits;
 use crate::math::{clamp, deg_to_rad};
 use crate::time::{Tick, TickRate};
 
-/// How the climb places the feet and how far it walks.
+/// How the climb places the feet and how far it crawls.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClimbConfig {
     /// Where the back feet go above the plateau: behind their hips, m.
@@ -140,14 +142,14 @@ pub enum Phase {
         /// Cycles done before this one.
         cycle: u8,
     },
-    /// Crawl cycle `cycle`: the `foot`-th foot (back feet first) stepping back.
+    /// Crawl cycle `cycle`: a back foot stepping back.
     Step {
         /// Cycles done before this one.
         cycle: u8,
-        /// Which foot of [`STEP_ORDER`].
+        /// Which back foot: 0 the left, 1 the right.
         foot: u8,
     },
-    /// The back legs shortening until the wheels stand on the plateau.
+    /// The legs shortening until the wheels stand on the plateau.
     Lower,
     /// Over, or given up.
     Ended(ClimbEnd),
@@ -430,7 +432,7 @@ pub fn solve(
     })
 }
 
-/// The order the feet step in within a crawl cycle: the back feet first, onto the plateau.
+/// The feet that step in a crawl cycle, in order: the back feet, on the plateau.
 const STEP_ORDER: [Leg; 2] = [Leg::Bl, Leg::Br];
 
 /// A foot stepping `config.crawl_m` back from `from`, `share` of the way through: lifted in
