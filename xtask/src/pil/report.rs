@@ -5,9 +5,10 @@ use pil_format::Recording;
 use super::compare::Check;
 use super::qemu::PilRun;
 
-/// Goals: instructions per control step, peak stack bytes.
+/// Goals: instructions per control step, peak stack bytes (8 KiB of the 128 KiB RAM until the
+/// step climb's state and the drives' reported torques took the peak past it).
 const INSTRUCTION_BUDGET: u64 = 20_000;
-const STACK_BUDGET: u64 = 8 * 1024;
+const STACK_BUDGET: u64 = 10 * 1024;
 
 /// Prints the figures; an error if a budget is exceeded.
 pub(super) fn print(recording: &Recording, pil: &PilRun, check: &Check) -> Result<(), String> {

@@ -15,6 +15,7 @@ use crate::time::Tick;
 impl Controller {
     /// A stall on the wheels at `now`: driving backward with a climb configured, the climb
     /// starts (`true`); otherwise the caller faults.
+    #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
     pub(super) fn climb_on_stall(&mut self, now: Tick) -> bool {
         let backward = self.state == State::Wheels(WheelMotion::Drive(Direction::Backward));
         if !backward || self.config.climb.is_none() {
@@ -35,6 +36,7 @@ impl Controller {
     }
 
     /// This tick of the climb: the legs' goal, and the trot while it walks.
+    #[inline(never)] // As `climb_on_stall`.
     pub(super) fn climb_step(&mut self, now: Tick) {
         let (Some(mut climb), Some(config)) = (self.climb, self.config.climb) else {
             self.apply(Event::PoseReached);
