@@ -196,6 +196,9 @@ wire_enum!(
         Drive = 8 => "Drive",
         /// Trot at the command's `speed` and `yaw_rate`.
         Walk = 9 => "Walk",
+        /// `H`: the autonomous hybrid mode. Drive on the wheels, back first, and climb by
+        /// itself the steps the wheels cannot roll over.
+        Auto = 10 => "Auto_H",
     }
 );
 
@@ -226,6 +229,10 @@ wire_enum!(
         Driving = 10 => "Driving",
         /// Trotting at the operator's speed and yaw rate.
         Walking = 11 => "Walking",
+        /// Driving on the wheels in the autonomous hybrid mode.
+        Auto = 12 => "Auto",
+        /// Climbing a step in the autonomous hybrid mode.
+        Climbing = 13 => "Climbing",
     }
 );
 
@@ -265,6 +272,11 @@ wire_flags!(
         /// swing (a step or a wall they cannot clear): the robot stopped and stands; cleared by
         /// the operator's next request.
         LEG_BLOCKED = 12 => "leg_blocked",
+        /// The autonomous mode met a step it does not climb (lower than the wheels roll
+        /// over, higher than the legs set a foot on, or no ground within their reach): the
+        /// robot folded back onto its wheels and balances; cleared by the operator's next
+        /// request.
+        STEP_REFUSED = 13 => "step_refused",
     }
 );
 

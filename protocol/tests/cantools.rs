@@ -124,6 +124,7 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
                 "wheel_stall",
                 "runaway",
                 "leg_blocked",
+                "step_refused",
             ];
             for (bit, flag) in flags.iter().enumerate() {
                 put(

@@ -1,8 +1,9 @@
-//! The climb of a step behind (`firmware::legs::climb`): driving S backward into a 6 cm step,
-//! the wheels stall against its riser and the robot climbs it by itself — front feet down,
-//! back feet set on the plateau, the legs lift it, crawl back, tip it onto its wheels there —
-//! and balances on the plateau. Seeded trials over the campaign's robots as built (rated
-//! drives, real IMU and estimator, a cycle of delay) and the distance to the step.
+//! The autonomous hybrid mode (`H`, `TeleopMode::Auto`) at a step: it drives on its wheels back
+//! first, its wheels stall against a 6 cm riser, and the robot climbs it by itself
+//! (`firmware::legs::climb`: front feet down, back feet set on the plateau, the legs lift it,
+//! crawl back, set it onto its wheels there) and drives on. Seeded trials over the campaign's
+//! robots as built (rated drives, real IMU and estimator, a cycle of delay) and the distance
+//! to the step. A manual drive (`S`) into the same step still stops with a stall fault.
 //!
 //! `cargo test --release -p sim-host --test climb -- --nocapture` prints each robot's figures.
 
@@ -59,21 +60,27 @@ impl Figures {
     }
 }
 
-/// Backs robot `seed` into a 6 cm riser `distance_m` behind it and runs for `end_s`.
-fn climb(seed: u64, distance_m: f64, end_s: f64) -> Figures {
+/// Drives robot `seed` in `mode` toward a 6 cm riser `distance_m` behind it and runs for
+/// `end_s`.
+fn climb(seed: u64, mode: TeleopMode, distance_m: f64, end_s: f64) -> Figures {
+    climb_step(seed, mode, STEP_M, distance_m, end_s)
+}
+
+/// As [`climb`], the step `height_m` high.
+fn climb_step(seed: u64, mode: TeleopMode, height_m: f64, distance_m: f64, end_s: f64) -> Figures {
     let riser_x_m = -distance_m;
     let scene = Scene::Step(Step {
-        height_m: STEP_M,
+        height_m,
         riser_x_m: riser_x_m - PLATEAU_M,
         depth_m: PLATEAU_M,
     });
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("climb")
-        .join(seed.to_string());
+        .join(format!("{height_m}-{seed}"));
     let model = mjcf::write(&scene, Path::new(DEFAULT_MODEL), &dir).unwrap();
     let plan = vec![
         PlanStep::at(0.0, TeleopMode::Fold),
-        PlanStep::at(4.0, TeleopMode::WheelBackward),
+        PlanStep::at(4.0, mode),
         PlanStep::at(STOP_S, TeleopMode::Stop),
     ];
     let faults = Faults::default();
@@ -129,12 +136,12 @@ fn crossed(f: &Figures) -> bool {
 /// Seeded trials, the riser 1–2 m behind: at least 22 of 24 robots cross (measured: see
 /// docs/obstacles.md).
 #[test]
-fn backing_into_a_6cm_step_the_robot_climbs_it_and_balances_on_the_plateau() {
+fn in_the_autonomous_mode_the_robot_climbs_a_6cm_step_and_drives_on() {
     const TRIALS: u64 = 24;
     let mut crossings = 0;
     for seed in 0..TRIALS {
         let distance_m = 1.0 + 1.0 * Draw::new(seed ^ 0xc11b_0000).unit();
-        let f = climb(seed, distance_m, STOP_S + 4.0);
+        let f = climb(seed, TeleopMode::Auto, distance_m, STOP_S + 4.0);
         let ok = crossed(&f);
         crossings += u64::from(ok);
         println!(
@@ -144,4 +151,44 @@ fn backing_into_a_6cm_step_the_robot_climbs_it_and_balances_on_the_plateau() {
     }
     println!("MEASURED {crossings} of {TRIALS} crossed");
     assert!(crossings >= 22, "{crossings} of {TRIALS} crossed");
+}
+
+/// `S` is the operator's drive, not the autonomous mode: into the same step it stops with a
+/// stall fault where it met it, and does not climb.
+#[test]
+fn a_manual_drive_into_the_step_stops_with_a_stall_fault_and_does_not_climb() {
+    for seed in 0..4 {
+        let f = climb(seed, TeleopMode::WheelBackward, 1.2, 12.0);
+        println!("MEASURED S, seed {seed}: {f:?}");
+        assert!(f.fell_at.is_none(), "seed {seed}: {f:?}");
+        assert!(
+            !f.states.iter().any(|(_, s)| *s == State::Climbing),
+            "seed {seed}: {f:?}"
+        );
+        assert_eq!(f.state, Some(State::Fault), "seed {seed}: {f:?}");
+        assert!(f.torso_z_m < ON_WHEELS_M + 0.03, "seed {seed}: {f:?}");
+    }
+}
+
+/// Higher steps, measured, not asserted (a long task: `cargo test --release -p sim-host --test
+/// climb -- --ignored --nocapture`): how many of 12 robots cross 8 cm, and what happens at
+/// 10 cm, where the climb should step down again and report `step_refused`.
+#[test]
+#[ignore = "measurement: the 8 and 10 cm figures in docs/obstacles.md"]
+fn higher_steps_measured() {
+    for height_m in [0.08, 0.10] {
+        let (mut crossed_on_top, mut refused, mut fell) = (0, 0, 0);
+        for seed in 0..12 {
+            let distance_m = 1.0 + 1.0 * Draw::new(seed ^ 0xc11b_0000).unit();
+            let f = climb_step(seed, TeleopMode::Auto, height_m, distance_m, STOP_S + 4.0);
+            let on_top = f.fell_at.is_none() && f.torso_z_m > ON_WHEELS_M + height_m - 0.01;
+            crossed_on_top += u32::from(on_top);
+            refused += u32::from(f.state == Some(State::Wheels(WheelMotion::Balance)) && !on_top);
+            fell += u32::from(f.fell_at.is_some());
+            println!("MEASURED {height_m} m, seed {seed}: on top {on_top}: {f:?}");
+        }
+        println!(
+            "MEASURED {height_m} m: {crossed_on_top} of 12 on top, {refused} refused and balancing, {fell} fell"
+        );
+    }
 }

@@ -202,6 +202,7 @@ pub fn mode_text(mode: protocol::TeleopMode) -> &'static str {
         M::Fold => "F fold onto the wheels",
         M::Drive => "drive on the wheels at the sticks' speed and yaw rate",
         M::Walk => "walk on the legs at the sticks' speed and yaw rate",
+        M::Auto => "H drive on by itself, back first, climbing steps",
     }
 }
 

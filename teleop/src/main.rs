@@ -18,7 +18,8 @@ use teleop_core::scenario::{mode_name, Scenario};
 /// Drive the hybrid wheel–leg robot over CAN with the report's keys.
 ///
 /// Without a subcommand teleop opens its terminal UI: W/S wheels forward/backward, A rotate,
-/// L/K trot forward/backward, X stop, T stand, F fold, ↑/↓ body height, ]/[ speed, space
+/// L/K trot forward/backward, X stop, T stand, F fold, H autonomous (drive back first and
+/// climb steps), ↑/↓ body height, ]/[ speed, space
 /// E-stop (R twice releases it), Q quit. It sends the operator's heartbeat at 50 Hz; when
 /// teleop quits or dies the controller stops the robot within 500 ms.
 ///

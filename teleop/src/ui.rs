@@ -14,7 +14,7 @@ use crate::app::{mode_text, App};
 
 /// The keys, as the help line shows them.
 pub const KEY_HELP: &str = "W/S wheels fwd/back · A rotate · L/K trot fwd/back · X stop · \
-T stand · F fold · ←/→ steer · ↑/↓ height · ]/[ speed · space E-STOP · R R release · Q quit";
+T stand · F fold · H auto · ←/→ steer · ↑/↓ height · ]/[ speed · space E-STOP · R R release · Q quit";
 
 /// Draws the whole screen for time `now_ms`.
 pub fn draw(frame: &mut Frame, app: &App, now_ms: u64) {

@@ -130,6 +130,9 @@ pub struct Controller {
     climb: Option<Climb>,
     /// Whether the running fold follows a climb that set the robot on its wheels.
     climbed: bool,
+    /// Whether the autonomous mode gave up a climb: reported until the operator's next
+    /// request.
+    step_refused: bool,
 }
 
 impl Controller {
@@ -180,6 +183,7 @@ impl Controller {
             heading: (HeadingHold::default(), 0.0),
             climb: None,
             climbed: false,
+            step_refused: false,
         })
     }
 
@@ -360,6 +364,7 @@ impl Controller {
         {
             // The operator has seen the stop and asks for something: the report has served.
             self.leg_blocked = false;
+            self.step_refused = false;
         }
         let next = self.state.next(event);
         if next == self.state {

@@ -23,7 +23,8 @@
 //! | `Fault`            | —                                                    | —              | —                 | —                | —                 | —             |
 //!
 //! `Walk` requests `LegMotion::Walk` (the trot at the operator's speed and yaw rate) where the
-//! table says `Trot d`, and `Drive` requests `WheelMotion::Velocity` where it says `w`.
+//! table says `Trot d`, and `Drive` requests `WheelMotion::Velocity` and `Auto` (`H`)
+//! `WheelMotion::Auto` where it says `w`.
 //!
 //! Events that reach every state alike:
 //!
@@ -34,10 +35,10 @@
 //! | `Fault`       | `Fault` from any state but `EStop` (an E-stop outranks a fault)            |
 //! | `Reset`       | `Fault` → `Hold` (sent when the operator asks to stop and no cause remains); no effect elsewhere |
 //!
-//! `Climbing` is entered by the controller itself, not by a request: a backward drive whose
-//! wheels stall against a step climbs it ([`crate::legs::climb`]), and its end (on the
-//! plateau, or given up) is its `PoseReached`. Requests wait for that end; an E-stop or a
-//! fault does not.
+//! `Climbing` is entered by the controller itself, not by a request: in the autonomous mode
+//! (`Wheels(Auto)`) a stall of the wheels against a step starts its climb
+//! ([`crate::legs::climb`]), and its end (on the plateau, or given up) is its `PoseReached`.
+//! Requests wait for that end; an E-stop or a fault does not.
 //!
 //! `Hold` is where the robot starts and where it returns after a clear or a reset: the drives
 //! hold their present positions and nothing moves until the operator asks for a motion.
@@ -82,6 +83,9 @@ pub enum WheelMotion {
     Rotate,
     /// Drive at the operator's speed and yaw rate ([`TeleopMode::Drive`]).
     Velocity,
+    /// The autonomous hybrid mode ([`TeleopMode::Auto`]): drive backward at the preset speed
+    /// and climb the steps the wheels stall against ([`crate::legs::climb`]).
+    Auto,
 }
 
 impl WheelMotion {
@@ -186,6 +190,7 @@ impl State {
             TeleopMode::WheelRotate => self.to_wheels(WheelMotion::Rotate),
             TeleopMode::Drive => self.to_wheels(WheelMotion::Velocity),
             TeleopMode::Walk => self.to_legs(LegMotion::Walk),
+            TeleopMode::Auto => self.to_wheels(WheelMotion::Auto),
         }
     }
 
@@ -211,7 +216,9 @@ impl State {
             }
             State::Legs(LegMotion::Trot(Direction::Forward)) => ControllerMode::TrotForward,
             State::Legs(LegMotion::Trot(Direction::Backward)) => ControllerMode::TrotBackward,
-            State::Standing(_) | State::Climbing => ControllerMode::Standing,
+            State::Standing(_) => ControllerMode::Standing,
+            State::Climbing => ControllerMode::Climbing,
+            State::Wheels(WheelMotion::Auto) => ControllerMode::Auto,
             State::Folding(_) => ControllerMode::Folding,
             State::Wheels(WheelMotion::Drive(Direction::Forward)) => ControllerMode::WheelForward,
             State::Wheels(WheelMotion::Drive(Direction::Backward)) => ControllerMode::WheelBackward,

@@ -109,7 +109,7 @@ impl ClimbConfig {
         lower_back_m: 0.10,
         lower_front_m: 0.045,
         step_min_m: 0.03,
-        step_max_m: 0.11,
+        step_max_m: 0.09,
     };
 }
 
@@ -137,6 +137,8 @@ pub enum Phase {
     Probe,
     /// The legs lengthening.
     Rise,
+    /// The legs shortening again onto the wheels, the step too high or too low.
+    Retreat,
     /// Crawl cycle `cycle`: the body shifting back over the planted feet.
     Shift {
         /// Cycles done before this one.
@@ -175,6 +177,8 @@ pub struct Climb {
     target: PerLeg<Foot>,
     /// Which feet are down.
     down: PerLeg<bool>,
+    /// Each foot's target when the rise began (where a retreat returns to).
+    before_rise: PerLeg<Foot>,
 }
 
 impl Climb {
@@ -187,6 +191,7 @@ impl Climb {
             from: feet,
             target: feet,
             down: PerLeg::splat(false),
+            before_rise: feet,
         }
     }
 
@@ -221,8 +226,9 @@ impl Climb {
         match self.phase {
             Phase::Prop => self.prop(config, rate, now, t_s, loads_n),
             Phase::Reach => self.reach(config, now, t_s),
-            Phase::Probe => self.probe(config, rate, now, loads_n, pitch_rad),
-            Phase::Rise => self.rise(config, now, t_s),
+            Phase::Probe => self.probe(config, rate, now, loads_n),
+            Phase::Rise => self.rise(config, now, t_s, pitch_rad),
+            Phase::Retreat => self.retreat(config, t_s),
             Phase::Shift { cycle } => self.shift(config, now, t_s, cycle),
             Phase::Step { cycle, foot } => self.step(config, now, t_s, cycle, foot),
             Phase::Lower => self.lower_onto_wheels(config, t_s),
@@ -273,19 +279,14 @@ impl Climb {
         rate: TickRate,
         now: Tick,
         loads_n: &PerLeg<Option<f32>>,
-        pitch_rad: f32,
     ) {
         if self.lower([Leg::Bl, Leg::Br], config, rate, loads_n) {
-            let step_m = self.step_height_m(config, pitch_rad);
-            if !(config.step_min_m..=config.step_max_m).contains(&step_m) {
-                self.phase = Phase::Ended(ClimbEnd::StepOutOfRange);
-            } else {
-                self.enter(Phase::Rise, now);
-            }
+            self.enter(Phase::Rise, now);
+            self.before_rise = self.target;
         }
     }
 
-    fn rise(&mut self, config: &ClimbConfig, now: Tick, t_s: f32) {
+    fn rise(&mut self, config: &ClimbConfig, now: Tick, t_s: f32, pitch_rad: f32) {
         let share = clamp(t_s / (config.rise_ms as f32 * 1e-3), 0.0, 1.0);
         let s = smoothstep(share);
         for leg in Leg::ALL {
@@ -300,7 +301,25 @@ impl Climb {
             };
         }
         if share >= 1.0 {
-            self.enter(Phase::Shift { cycle: 0 }, now);
+            // Each pair now stands at its own depth; the body's pitch says how much higher the
+            // back feet stand than the front ones. A step the crawl does not carry the robot
+            // over safely is stepped down from again.
+            let step_m = self.step_height_m(config, pitch_rad);
+            if (config.step_min_m..=config.step_max_m).contains(&step_m) {
+                self.enter(Phase::Shift { cycle: 0 }, now);
+            } else {
+                self.enter(Phase::Retreat, now);
+            }
+        }
+    }
+
+    fn retreat(&mut self, config: &ClimbConfig, t_s: f32) {
+        let share = t_s / (config.rise_ms as f32 * 1e-3);
+        for leg in Leg::ALL {
+            *self.target.get_mut(leg) = blend(self.from.get(leg), self.before_rise.get(leg), share);
+        }
+        if share >= 1.0 {
+            self.phase = Phase::Ended(ClimbEnd::StepOutOfRange);
         }
     }
 

@@ -66,8 +66,8 @@ pub enum Action {
 /// One press of `←` or `→`, rad/s.
 pub const STEER_STEP_RAD_S: f32 = 0.1;
 
-/// The report's key for `mode`, if it has one (stand and fold have none: `T` and `F` are this
-/// program's; drive and walk follow a gamepad's sticks).
+/// The report's key for `mode`, if it has one (stand, fold and the autonomous mode have none:
+/// `T`, `F` and `H` are this program's; drive and walk follow a gamepad's sticks).
 pub const fn mode_key(mode: TeleopMode) -> Option<char> {
     match mode {
         TeleopMode::Stop => Some('X'),
@@ -76,7 +76,11 @@ pub const fn mode_key(mode: TeleopMode) -> Option<char> {
         TeleopMode::WheelRotate => Some('A'),
         TeleopMode::TrotForward => Some('L'),
         TeleopMode::TrotBackward => Some('K'),
-        TeleopMode::Stand | TeleopMode::Fold | TeleopMode::Drive | TeleopMode::Walk => None,
+        TeleopMode::Stand
+        | TeleopMode::Fold
+        | TeleopMode::Drive
+        | TeleopMode::Walk
+        | TeleopMode::Auto => None,
     }
 }
 
@@ -105,6 +109,7 @@ pub fn action(key: Key) -> Option<Action> {
             ' ' => Action::EStop,
             'T' => Action::Mode(TeleopMode::Stand),
             'F' => Action::Mode(TeleopMode::Fold),
+            'H' => Action::Mode(TeleopMode::Auto),
             ']' => Action::Speed(10.0),
             '[' => Action::Speed(-10.0),
             'R' => Action::Release,

@@ -7,7 +7,7 @@
 //!
 //! [[step]]
 //! at_s = 0.0
-//! mode = "fold"               # W S A L K X (the report's keys), stand, fold, drive, walk
+//! mode = "fold"               # W S A L K X (the report's keys), stand, fold, drive, walk, auto
 //!
 //! [[step]]
 //! at_s = 3.0
@@ -112,13 +112,15 @@ struct RawStep {
 }
 
 /// The mode a scenario (or `--drive`) names: the report's keys W S A L K X, `stand`, `fold`,
-/// `drive` and `walk` (at a ground speed and yaw rate).
+/// `drive` and `walk` (at a ground speed and yaw rate), and `auto` (the autonomous hybrid
+/// mode, `H` in the teleop).
 pub fn parse_mode(text: &str) -> Option<TeleopMode> {
     match text.trim().to_ascii_lowercase().as_str() {
         "stand" => Some(TeleopMode::Stand),
         "fold" => Some(TeleopMode::Fold),
         "drive" => Some(TeleopMode::Drive),
         "walk" => Some(TeleopMode::Walk),
+        "auto" => Some(TeleopMode::Auto),
         key => {
             let mut chars = key.chars();
             match (chars.next(), chars.next()) {
@@ -214,13 +216,15 @@ pub fn parse_drive_step(text: &str) -> Result<PlanStep, String> {
     Ok(step)
 }
 
-/// The label of a mode in summaries: the report's key, or `stand` / `fold` / `drive` / `walk`.
+/// The label of a mode in summaries: the report's key, or `stand` / `fold` / `drive` / `walk` /
+/// `auto`.
 pub fn mode_name(mode: TeleopMode) -> String {
     match mode {
         TeleopMode::Stand => "stand".into(),
         TeleopMode::Fold => "fold".into(),
         TeleopMode::Drive => "drive".into(),
         TeleopMode::Walk => "walk".into(),
+        TeleopMode::Auto => "auto".into(),
         other => mode_key(other).map(String::from).unwrap_or_default(),
     }
 }

@@ -1,11 +1,11 @@
-//! The climb of a step behind ([`crate::legs::climb`]): started where a backward drive
-//! stalls against a riser, the feet placed by their drives' loads, then a fold onto the
-//! wheels over the plateau.
+//! The climb of a step behind ([`crate::legs::climb`]): started where the autonomous mode's
+//! drive stalls against a riser, the feet placed by their drives' loads, then a fold onto the
+//! wheels over the plateau and on in the autonomous mode.
 
 use protocol::Leg;
 
 use super::Controller;
-use crate::control::fsm::{Direction, Event, State, WheelMotion};
+use crate::control::fsm::{Event, State, WheelMotion};
 use crate::legs::climb::{solve, Climb, ClimbEnd, Phase};
 use crate::legs::crawl::foot_loads_n;
 use crate::legs::crawl::frame::PerLeg;
@@ -13,12 +13,12 @@ use crate::legs::kinematics::{leg_fk, LegJoints};
 use crate::time::Tick;
 
 impl Controller {
-    /// A stall on the wheels at `now`: driving backward with a climb configured, the climb
-    /// starts (`true`); otherwise the caller faults.
+    /// A stall on the wheels at `now`: in the autonomous mode with a climb configured, the
+    /// climb starts (`true`); otherwise the caller faults (a manual drive into a step stops).
     #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
     pub(super) fn climb_on_stall(&mut self, now: Tick) -> bool {
-        let backward = self.state == State::Wheels(WheelMotion::Drive(Direction::Backward));
-        if !backward || self.config.climb.is_none() {
+        let autonomous = self.state == State::Wheels(WheelMotion::Auto);
+        if !autonomous || self.config.climb.is_none() {
             return false;
         }
         let measured =
@@ -35,7 +35,7 @@ impl Controller {
         self.climb.as_ref()
     }
 
-    /// This tick of the climb: the legs' goal, and the trot while it walks.
+    /// This tick of the climb: the legs' goal; at its end the fold.
     #[inline(never)] // As `climb_on_stall`.
     pub(super) fn climb_step(&mut self, now: Tick) {
         let (Some(mut climb), Some(config)) = (self.climb, self.config.climb) else {
@@ -57,17 +57,15 @@ impl Controller {
         self.climb = Some(climb);
         match climb.phase() {
             Phase::Ended(end) => {
-                if end != ClimbEnd::Over {
-                    self.leg_blocked = true;
-                }
+                self.step_refused = end != ClimbEnd::Over;
                 self.climb = None;
                 self.apply(Event::PoseReached);
                 if end == ClimbEnd::Over {
-                    // Over the step: the fold onto the wheels, then on backward as the operator
-                    // asked. A climb given up folds and balances (backing on would meet the
-                    // same riser).
+                    // Over the step: the fold onto the wheels, then on in the autonomous mode.
+                    // A climb given up folds and balances (backing on would meet the same
+                    // riser) and reports why.
                     self.climbed = true;
-                    self.apply(Event::Request(protocol::TeleopMode::WheelBackward));
+                    self.apply(Event::Request(protocol::TeleopMode::Auto));
                 }
             }
             _ => {

@@ -26,6 +26,9 @@ impl Controller {
         if self.leg_blocked {
             faults = faults.with(FaultFlags::LEG_BLOCKED);
         }
+        if self.step_refused {
+            faults = faults.with(FaultFlags::STEP_REFUSED);
+        }
         if self.teleop.interlocked() {
             faults = faults.with(FaultFlags::AWAITING_STOP);
         }

@@ -71,7 +71,7 @@ impl Controller {
         let yaw_rad_s = self.teleop.yaw_rate_rad_s;
         match self.state {
             State::Wheels(WheelMotion::Drive(Direction::Forward)) => (preset_m_s, turn(yaw_rad_s)),
-            State::Wheels(WheelMotion::Drive(Direction::Backward)) => {
+            State::Wheels(WheelMotion::Drive(Direction::Backward) | WheelMotion::Auto) => {
                 (-preset_m_s, turn(yaw_rad_s))
             }
             State::Wheels(WheelMotion::Rotate) => {
