@@ -23,8 +23,8 @@ use teleop_core::scripted::PlanStep;
 const STEP_M: f64 = 0.06;
 /// How deep the plateau is, m: room to drive on after the climb.
 const PLATEAU_M: f64 = 6.0;
-/// When the operator stops the drive, s (every climb has ended by then).
-const STOP_S: f64 = 25.0;
+/// How long a trial runs, s: every climb has ended by then, and the robot drives on.
+const END_S: f64 = 25.0;
 
 /// Height of the torso's origin over the ground balancing on the wheels, m.
 const ON_WHEELS_M: f64 = 0.27;
@@ -78,11 +78,7 @@ fn climb_step(seed: u64, mode: TeleopMode, height_m: f64, distance_m: f64, end_s
         .join("climb")
         .join(format!("{height_m}-{seed}"));
     let model = mjcf::write(&scene, Path::new(DEFAULT_MODEL), &dir).unwrap();
-    let plan = vec![
-        PlanStep::at(0.0, TeleopMode::Fold),
-        PlanStep::at(4.0, mode),
-        PlanStep::at(STOP_S, TeleopMode::Stop),
-    ];
+    let plan = vec![PlanStep::at(0.0, TeleopMode::Fold), PlanStep::at(4.0, mode)];
     let faults = Faults::default();
     let plant = Draws::of(seed).plant(Drives::Rated.ratings());
     let mut rig = Rig::with_plant(&model, plan, &faults, &faults, plant).unwrap();
@@ -121,14 +117,14 @@ const MAX_CLIMB_S: f64 = 20.0;
 /// The largest tilt a crossing of a 6 cm step may show, degrees (the pitch figure).
 const MAX_TILT_DEG: f64 = 25.0;
 
-/// Whether `f` is a crossing: balancing on the wheels on the plateau (the torso a step's
-/// height above where it rides on flat ground, the axle past the riser), never fallen nor
-/// tilted past [`MAX_TILT_DEG`].
+/// Whether `f` is a crossing: driving on in the autonomous mode on the plateau (the torso a
+/// step's height above where it rides on flat ground, the axle past the riser), never fallen
+/// nor tilted past [`MAX_TILT_DEG`].
 fn crossed(f: &Figures) -> bool {
     f.fell_at.is_none()
         && f.climb_s().is_some_and(|s| s <= MAX_CLIMB_S)
         && f.max_tilt_deg <= MAX_TILT_DEG
-        && f.state == Some(State::Wheels(WheelMotion::Balance))
+        && f.state == Some(State::Wheels(WheelMotion::Auto))
         && f.torso_z_m > ON_WHEELS_M + STEP_M - 0.01
         && f.onto_plateau_m > 0.05
 }
@@ -141,7 +137,7 @@ fn in_the_autonomous_mode_the_robot_climbs_a_6cm_step_and_drives_on() {
     let mut crossings = 0;
     for seed in 0..TRIALS {
         let distance_m = 1.0 + 1.0 * Draw::new(seed ^ 0xc11b_0000).unit();
-        let f = climb(seed, TeleopMode::Auto, distance_m, STOP_S + 4.0);
+        let f = climb(seed, TeleopMode::Auto, distance_m, END_S);
         let ok = crossed(&f);
         crossings += u64::from(ok);
         println!(
@@ -180,7 +176,7 @@ fn higher_steps_measured() {
         let (mut crossed_on_top, mut refused, mut fell) = (0, 0, 0);
         for seed in 0..12 {
             let distance_m = 1.0 + 1.0 * Draw::new(seed ^ 0xc11b_0000).unit();
-            let f = climb_step(seed, TeleopMode::Auto, height_m, distance_m, STOP_S + 4.0);
+            let f = climb_step(seed, TeleopMode::Auto, height_m, distance_m, END_S);
             let on_top = f.fell_at.is_none() && f.torso_z_m > ON_WHEELS_M + height_m - 0.01;
             crossed_on_top += u32::from(on_top);
             refused += u32::from(f.state == Some(State::Wheels(WheelMotion::Balance)) && !on_top);

@@ -49,8 +49,12 @@ pub struct ClimbConfig {
     pub probe_m_s: f32,
     /// Deepest a foot is lowered looking for ground, m below its hip.
     pub probe_depth_max_m: f32,
-    /// A foot carrying this much is down, N.
+    /// A foot carrying this much is down, N, …
     pub touchdown_n: f32,
+    /// … and standing this much higher than it is sent, m: stopped by the ground. The load
+    /// alone reads 15–25 N on a foot in the air in the prop's and the reach's poses (the hip and
+    /// knee torques also hold the leg's own weight and swing).
+    pub touchdown_lag_m: f32,
     /// How much deeper than where it touched a foot is then held, m (its share of the weight).
     pub preload_m: f32,
     /// Half the distance between the front and back hips, m (the body's pitch moves each pair
@@ -83,6 +87,9 @@ pub struct ClimbConfig {
     pub step_min_m: f32,
     /// Steps higher than this (m) are not climbed.
     pub step_max_m: f32,
+    /// A body pitched further nose down than this when the back feet are down is not lifted,
+    /// rad.
+    pub pitch_max_rad: f32,
 }
 
 impl ClimbConfig {
@@ -95,7 +102,8 @@ impl ClimbConfig {
         prop_depth_m: 0.18,
         probe_m_s: 0.06,
         probe_depth_max_m: 0.31,
-        touchdown_n: 25.0,
+        touchdown_n: 15.0,
+        touchdown_lag_m: 0.01,
         preload_m: 0.01,
         hip_half_span_m: 0.22,
         front_depth_m: 0.36,
@@ -110,6 +118,7 @@ impl ClimbConfig {
         lower_front_m: 0.045,
         step_min_m: 0.03,
         step_max_m: 0.09,
+        pitch_max_rad: deg_to_rad(12.0),
     };
 }
 
@@ -126,6 +135,18 @@ pub enum ClimbEnd {
     StepOutOfRange,
 }
 
+/// What the climb reads from the drives each tick.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ClimbInput {
+    /// Each foot's load from its hip and knee torques, N (`None`: not known).
+    pub loads_n: PerLeg<Option<f32>>,
+    /// How much higher each foot stands than it is sent (the commanded pose's depth less the
+    /// measured pose's), m.
+    pub lag_m: PerLeg<f32>,
+    /// The body's estimated pitch, rad, positive nose down.
+    pub pitch_rad: f32,
+}
+
 /// Where the climb is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Phase {
@@ -137,7 +158,8 @@ pub enum Phase {
     Probe,
     /// The legs lengthening.
     Rise,
-    /// The legs shortening again onto the wheels, the step too high or too low.
+    /// The legs going back to where they were before the rise (or the climb), the step too
+    /// high or too low.
     Retreat,
     /// Crawl cycle `cycle`: the body shifting back over the planted feet.
     Shift {
@@ -177,7 +199,8 @@ pub struct Climb {
     target: PerLeg<Foot>,
     /// Which feet are down.
     down: PerLeg<bool>,
-    /// Each foot's target when the rise began (where a retreat returns to).
+    /// Each foot's target when the rise began, or when the climb began until then: where a
+    /// retreat returns to.
     before_rise: PerLeg<Foot>,
 }
 
@@ -213,20 +236,14 @@ impl Climb {
             + 2.0 * config.hip_half_span_m * crate::math::sin(pitch_rad)
     }
 
-    /// One tick at `now`: `loads_n` is each foot's load from its drives (`None`: not known).
-    pub fn tick(
-        &mut self,
-        config: &ClimbConfig,
-        rate: TickRate,
-        now: Tick,
-        loads_n: &PerLeg<Option<f32>>,
-        pitch_rad: f32,
-    ) {
+    /// One tick at `now` with what the drives report (`input`).
+    pub fn tick(&mut self, config: &ClimbConfig, rate: TickRate, now: Tick, input: &ClimbInput) {
+        let pitch_rad = input.pitch_rad;
         let t_s = now.since(self.since) as f32 * rate.period_s();
         match self.phase {
-            Phase::Prop => self.prop(config, rate, now, t_s, loads_n),
+            Phase::Prop => self.prop(config, rate, now, t_s, input),
             Phase::Reach => self.reach(config, now, t_s),
-            Phase::Probe => self.probe(config, rate, now, loads_n),
+            Phase::Probe => self.probe(config, rate, now, input),
             Phase::Rise => self.rise(config, now, t_s, pitch_rad),
             Phase::Retreat => self.retreat(config, t_s),
             Phase::Shift { cycle } => self.shift(config, now, t_s, cycle),
@@ -242,7 +259,7 @@ impl Climb {
         rate: TickRate,
         now: Tick,
         t_s: f32,
-        loads_n: &PerLeg<Option<f32>>,
+        input: &ClimbInput,
     ) {
         let share = t_s / (config.reach_ms as f32 * 1e-3);
         let goal = Foot {
@@ -254,7 +271,7 @@ impl Climb {
                 *self.target.get_mut(leg) = blend(self.from.get(leg), goal, share);
             }
         }
-        if self.lower([Leg::Fl, Leg::Fr], config, rate, loads_n) {
+        if self.lower([Leg::Fl, Leg::Fr], config, rate, input) {
             self.enter(Phase::Reach, now);
         }
     }
@@ -273,16 +290,19 @@ impl Climb {
         }
     }
 
-    fn probe(
-        &mut self,
-        config: &ClimbConfig,
-        rate: TickRate,
-        now: Tick,
-        loads_n: &PerLeg<Option<f32>>,
-    ) {
-        if self.lower([Leg::Bl, Leg::Br], config, rate, loads_n) {
-            self.enter(Phase::Rise, now);
-            self.before_rise = self.target;
+    fn probe(&mut self, config: &ClimbConfig, rate: TickRate, now: Tick, input: &ClimbInput) {
+        if self.lower([Leg::Bl, Leg::Br], config, rate, input) {
+            // A riser the wheels have started up tips the robot forward over its front feet
+            // (19° at 10 cm, against 2–10° nose up at 6 and 8 cm): refused before the legs
+            // lift it (the rise from there tipped it over). The back feet's touchdown reads
+            // too early to tell the height here.
+            if input.pitch_rad > config.pitch_max_rad {
+                // Back to where the legs were when the wheels stalled.
+                self.enter(Phase::Retreat, now);
+            } else {
+                self.enter(Phase::Rise, now);
+                self.before_rise = self.target;
+            }
         }
     }
 
@@ -387,14 +407,18 @@ impl Climb {
         legs: [Leg; 2],
         config: &ClimbConfig,
         rate: TickRate,
-        loads_n: &PerLeg<Option<f32>>,
+        input: &ClimbInput,
     ) -> bool {
         let step_m = config.probe_m_s * rate.period_s();
         for leg in legs {
             if self.down.get(leg) {
                 continue;
             }
-            let carries = loads_n.get(leg).is_some_and(|n| n >= config.touchdown_n);
+            let loaded = input
+                .loads_n
+                .get(leg)
+                .is_some_and(|n| n >= config.touchdown_n);
+            let carries = loaded && input.lag_m.get(leg) >= config.touchdown_lag_m;
             let foot = self.target.get_mut(leg);
             if carries {
                 foot.depth_m += config.preload_m;

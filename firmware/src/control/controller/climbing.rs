@@ -2,11 +2,11 @@
 //! drive stalls against a riser, the feet placed by their drives' loads, then a fold onto the
 //! wheels over the plateau and on in the autonomous mode.
 
-use protocol::Leg;
+use protocol::{Joints, Leg};
 
 use super::Controller;
 use crate::control::fsm::{Event, State, WheelMotion};
-use crate::legs::climb::{solve, Climb, ClimbEnd, Phase};
+use crate::legs::climb::{foot_of, solve, Climb, ClimbEnd, ClimbInput, Phase};
 use crate::legs::crawl::foot_loads_n;
 use crate::legs::crawl::frame::PerLeg;
 use crate::legs::kinematics::{leg_fk, LegJoints};
@@ -42,18 +42,22 @@ impl Controller {
             self.apply(Event::PoseReached);
             return;
         };
-        let loads = foot_loads_n(
-            &self.config.geometry,
-            &self.sensors.joint_position_rad,
-            &self.sensors.joint_effort_nm,
-        );
-        climb.tick(
-            &config,
-            self.config.rate,
-            now,
-            &loads,
-            self.sensors.attitude.pitch_rad,
-        );
+        let geometry = &self.config.geometry;
+        let depth_of = |joints: &Joints<f32>, leg: Leg| {
+            foot_of(geometry, &LegJoints::from_array(*joints.leg(leg))).depth_m
+        };
+        let input = ClimbInput {
+            loads_n: foot_loads_n(
+                geometry,
+                &self.sensors.joint_position_rad,
+                &self.sensors.joint_effort_nm,
+            ),
+            lag_m: PerLeg::from_fn(|leg| {
+                depth_of(&self.legs_rad, leg) - depth_of(&self.sensors.joint_position_rad, leg)
+            }),
+            pitch_rad: self.sensors.attitude.pitch_rad,
+        };
+        climb.tick(&config, self.config.rate, now, &input);
         self.climb = Some(climb);
         match climb.phase() {
             Phase::Ended(end) => {
