@@ -16,6 +16,8 @@ fn all_states() -> Vec<State> {
         DRIVE_F,
         WheelMotion::Drive(Backward),
         WheelMotion::Rotate,
+        WheelMotion::Velocity,
+        WheelMotion::Auto,
     ];
     let mut states = vec![State::Hold, State::EStop, State::Fault];
     for m in legs {
@@ -25,6 +27,7 @@ fn all_states() -> Vec<State> {
     for m in wheels {
         states.push(State::Folding(m));
         states.push(State::Wheels(m));
+        states.push(State::Climbing(m));
     }
     states
 }
@@ -39,6 +42,9 @@ fn all_events() -> Vec<Event> {
         TeleopMode::TrotBackward,
         TeleopMode::Stand,
         TeleopMode::Fold,
+        TeleopMode::Drive,
+        TeleopMode::Walk,
+        TeleopMode::Auto,
     ]
     .into_iter()
     .map(Event::Request)
@@ -47,6 +53,8 @@ fn all_events() -> Vec<Event> {
         Event::TeleopLost,
         Event::LinkDegraded,
         Event::LegBlocked,
+        Event::StepStall,
+        Event::StepRefused,
         Event::PoseReached,
         Event::EStopLatch,
         Event::EStopClear,
@@ -184,11 +192,17 @@ fn every_request_in_every_state_has_a_defined_safe_result() {
             if state == State::Fault && !matches!(event, Event::Reset | Event::EStopLatch) {
                 assert_eq!(next, State::Fault, "{event:?} must not leave Fault");
             }
-            // A stop request never starts a motion.
+            // A stop request never starts a motion. A climb under way ends (back to the fold, or
+            // over the step) and then balances: it does not drive on.
             if matches!(
                 event,
-                Event::Request(TeleopMode::Stop) | Event::TeleopLost | Event::LinkDegraded
+                Event::Request(TeleopMode::Stop)
+                    | Event::TeleopLost
+                    | Event::LinkDegraded
+                    | Event::LegBlocked
+                    | Event::StepRefused
             ) {
+                let climbing = matches!(state, State::Climbing(_));
                 assert!(
                     matches!(
                         next.mode(),
@@ -197,8 +211,20 @@ fn every_request_in_every_state_has_a_defined_safe_result() {
                             | ControllerMode::Folding
                             | ControllerMode::EStop
                             | ControllerMode::Fault
-                    ),
+                    ) || (climbing && next == State::Climbing(WheelMotion::Balance)),
                     "{state:?} on {event:?} → {next:?}"
+                );
+                assert_ne!(
+                    next.next(Event::PoseReached).mode(),
+                    ControllerMode::Auto,
+                    "{state:?} on {event:?} then its end drives on"
+                );
+            }
+            // Only the autonomous mode's stall starts a climb.
+            if matches!(next, State::Climbing(_)) && !matches!(state, State::Climbing(_)) {
+                assert_eq!(
+                    (state, event),
+                    (State::Wheels(WheelMotion::Auto), Event::StepStall)
                 );
             }
         }
@@ -228,7 +254,7 @@ fn the_balance_law_runs_exactly_when_the_wheels_may_carry_the_robot() {
     for state in all_states() {
         let expected = matches!(
             state,
-            State::Folding(_) | State::Wheels(_) | State::Standing(_)
+            State::Folding(_) | State::Wheels(_) | State::Standing(_) | State::Climbing(_)
         );
         assert_eq!(state.balancing(), expected, "{state:?}");
     }

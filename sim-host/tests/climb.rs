@@ -50,7 +50,11 @@ struct Figures {
 impl Figures {
     /// From the start of the climb to the wheels carrying the robot again, s.
     fn climb_s(&self) -> Option<f64> {
-        let start = self.states.iter().find(|(_, s)| *s == State::Climbing)?.0;
+        let start = self
+            .states
+            .iter()
+            .find(|(_, s)| matches!(s, State::Climbing(_)))?
+            .0;
         let end = self
             .states
             .iter()
@@ -129,7 +133,7 @@ fn crossed(f: &Figures) -> bool {
         && f.onto_plateau_m > 0.05
 }
 
-/// Seeded trials, the riser 1–2 m behind: at least 22 of 24 robots cross (measured: see
+/// Seeded trials, the riser 1–2 m behind: at least 23 of 24 robots cross (measured: see
 /// docs/obstacles.md).
 #[test]
 fn in_the_autonomous_mode_the_robot_climbs_a_6cm_step_and_drives_on() {
@@ -146,7 +150,7 @@ fn in_the_autonomous_mode_the_robot_climbs_a_6cm_step_and_drives_on() {
         );
     }
     println!("MEASURED {crossings} of {TRIALS} crossed");
-    assert!(crossings >= 22, "{crossings} of {TRIALS} crossed");
+    assert!(crossings >= 23, "{crossings} of {TRIALS} crossed");
 }
 
 /// `S` is the operator's drive, not the autonomous mode: into the same step it stops with a
@@ -158,7 +162,9 @@ fn a_manual_drive_into_the_step_stops_with_a_stall_fault_and_does_not_climb() {
         println!("MEASURED S, seed {seed}: {f:?}");
         assert!(f.fell_at.is_none(), "seed {seed}: {f:?}");
         assert!(
-            !f.states.iter().any(|(_, s)| *s == State::Climbing),
+            !f.states
+                .iter()
+                .any(|(_, s)| matches!(s, State::Climbing(_))),
             "seed {seed}: {f:?}"
         );
         assert_eq!(f.state, Some(State::Fault), "seed {seed}: {f:?}");
@@ -179,7 +185,8 @@ fn higher_steps_measured() {
             let f = climb_step(seed, TeleopMode::Auto, height_m, distance_m, END_S);
             let on_top = f.fell_at.is_none() && f.torso_z_m > ON_WHEELS_M + height_m - 0.01;
             crossed_on_top += u32::from(on_top);
-            refused += u32::from(f.state == Some(State::Wheels(WheelMotion::Balance)) && !on_top);
+            let balancing = f.state == Some(State::Wheels(WheelMotion::Balance));
+            refused += u32::from(balancing && !on_top && f.fell_at.is_none());
             fell += u32::from(f.fell_at.is_some());
             println!("MEASURED {height_m} m, seed {seed}: on top {on_top}: {f:?}");
         }

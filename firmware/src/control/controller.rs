@@ -126,7 +126,7 @@ pub struct Controller {
     walk_direction: Direction,
     /// The trot's heading hold, and the yaw rate it gives the trot this tick, rad/s.
     heading: (HeadingHold, f32),
-    /// The climb under way (`State::Climbing`; `None` otherwise).
+    /// The climb under way (`State::Climbing(_)`; `None` otherwise).
     climb: Option<Climb>,
     /// Whether the running fold follows a climb that set the robot on its wheels.
     climbed: bool,
@@ -300,7 +300,7 @@ impl Controller {
                 self.smooth(rate);
             }
             State::Folding(_) => self.fold_step(now, depth_m),
-            State::Climbing => self.climb_step(now),
+            State::Climbing(_) => self.climb_step(now),
             State::Wheels(_) => {
                 self.goal_rad = self.fold_rad();
                 self.smooth(self.config.fold_rate_per_s);
@@ -352,6 +352,10 @@ impl Controller {
             self.fold_return = Some((now, self.carried_forward_m()));
         }
         let mut wheel_torque_nm = self.wheel_law(now, dt_s);
+        if matches!(self.state, State::Climbing(_)) {
+            // The wheels stalled this tick and a climb began: they hold from now.
+            return self.hold_wheels(dt_s);
+        }
         if matches!(self.state, State::Folding(_)) {
             self.ramp_in(&mut wheel_torque_nm, now.since(since));
             self.fold_ahead_m += self.ground_speed_m_s() * dt_s;
@@ -395,7 +399,7 @@ impl Controller {
             // A release moves nothing by itself: the operator sends STOP, then a motion.
             self.teleop.interlock();
         }
-        if next != State::Climbing {
+        if !matches!(next, State::Climbing(_)) {
             self.climb = None;
         }
         if next != State::EStop {

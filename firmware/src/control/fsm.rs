@@ -11,14 +11,14 @@
 //! steady states, `Standing(m)` / `Folding(m)` the transitions that end in them on `PoseReached`.
 //! `—` means the event leaves the state unchanged.
 //!
-//! | state ↓ / event →  | Stop (X), `TeleopLost`, `LinkDegraded`, `LegBlocked` | Stand          | Trot d (L/K/Walk) | Fold             | Wheel w (W/S/A/Drive) | `PoseReached` |
+//! | state ↓ / event →  | Stop (X), `TeleopLost`, `LinkDegraded`, `LegBlocked`, `StepRefused` | Stand          | Trot d (L/K/Walk) | Fold             | Wheel w (W/S/A/Drive/H) | `PoseReached` |
 //! |--------------------|----------------------------------------------------|----------------|-------------------|------------------|-------------------|---------------|
 //! | `Hold`             | —                                                    | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | —             |
 //! | `Legs(_)`          | Legs(Stand)                                          | Legs(Stand)    | Legs(Trot d)      | Folding(Balance) | Folding(w)        | —             |
 //! | `Standing(_)`      | Standing(Stand)                                      | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Legs(m)       |
 //! | `Folding(_)`       | Folding(Balance)                                     | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Wheels(m)     |
 //! | `Wheels(_)`        | Wheels(Balance)                                      | Standing(Stand)| Standing(Trot d)  | —                | Wheels(w)         | —             |
-//! | `Climbing`         | —                                                    | —              | —                 | —                | —                 | Folding(Balance) |
+//! | `Climbing(_)`      | Climbing(Balance)                                    | —              | —                 | —                | —                 | Folding(m)    |
 //! | `EStop`            | —                                                    | —              | —                 | —                | —                 | —             |
 //! | `Fault`            | —                                                    | —              | —                 | —                | —                 | —             |
 //!
@@ -35,10 +35,13 @@
 //! | `Fault`       | `Fault` from any state but `EStop` (an E-stop outranks a fault)            |
 //! | `Reset`       | `Fault` → `Hold` (sent when the operator asks to stop and no cause remains); no effect elsewhere |
 //!
-//! `Climbing` is entered by the controller itself, not by a request: in the autonomous mode
-//! (`Wheels(Auto)`) a stall of the wheels against a step starts its climb
-//! ([`crate::legs::climb`]), and its end (on the plateau, or given up) is its `PoseReached`.
-//! Requests wait for that end; an E-stop or a fault does not.
+//! `Climbing(m)` is entered by the controller itself: in the autonomous mode (`Wheels(Auto)`) a
+//! stall of the wheels against a step (`StepStall`, no effect elsewhere) starts its climb
+//! ([`crate::legs::climb`]), and its end is its `PoseReached`: a fold, then `m`. A stop (the
+//! operator's, a lost operator, a lossy link, or a climb given up) makes it `Climbing(Balance)`:
+//! the climb goes back to the fold if its legs have not lifted the robot yet, or ends over the
+//! step, and the robot balances there instead of driving on. Other requests are not taken
+//! while it climbs; an E-stop or a fault ends it at once.
 //!
 //! `Hold` is where the robot starts and where it returns after a clear or a reset: the drives
 //! hold their present positions and nothing moves until the operator asks for a motion.
@@ -110,8 +113,8 @@ pub enum State {
     Wheels(WheelMotion),
     /// Emergency stop: drives torque-free until [`Event::EStopClear`].
     EStop,
-    /// Climbing a step behind ([`crate::legs::climb`]); a fold follows.
-    Climbing,
+    /// Climbing a step behind ([`crate::legs::climb`]); a fold follows, then the motion.
+    Climbing(WheelMotion),
     /// A fault stopped the robot until [`Event::Reset`].
     Fault,
 }
@@ -129,6 +132,11 @@ pub enum Event {
     /// The trot's leading feet could not finish their swings ([`crate::legs::blocked`]):
     /// treated as a stop request (the robot stands on four legs).
     LegBlocked,
+    /// The autonomous mode's wheels stalled against a step: its climb starts.
+    StepStall,
+    /// The running climb gave up (a step out of its range, or no ground within reach):
+    /// treated as a stop request.
+    StepRefused,
     /// The legs arrived at the pose of the running transition.
     PoseReached,
     /// An E-stop frame asked to latch.
@@ -157,12 +165,25 @@ impl State {
             (_, Event::EStopClear | Event::Reset) => self,
             (State::Standing(motion), Event::PoseReached) => State::Legs(motion),
             (State::Folding(motion), Event::PoseReached) => State::Wheels(motion),
-            (State::Climbing, Event::PoseReached) => State::Folding(WheelMotion::Balance),
-            (State::Climbing, _) => State::Climbing,
-            (_, Event::PoseReached) => self,
-            (_, Event::TeleopLost | Event::LinkDegraded | Event::LegBlocked) => {
-                self.on_request(TeleopMode::Stop)
+            (State::Climbing(motion), Event::PoseReached) => State::Folding(motion),
+            (
+                State::Climbing(_),
+                Event::Request(TeleopMode::Stop)
+                | Event::TeleopLost
+                | Event::LinkDegraded
+                | Event::LegBlocked
+                | Event::StepRefused,
+            ) => State::Climbing(WheelMotion::Balance),
+            (State::Climbing(_), _) => self,
+            (State::Wheels(WheelMotion::Auto), Event::StepStall) => {
+                State::Climbing(WheelMotion::Auto)
             }
+            (_, Event::StepStall) => self,
+            (_, Event::PoseReached) => self,
+            (
+                _,
+                Event::TeleopLost | Event::LinkDegraded | Event::LegBlocked | Event::StepRefused,
+            ) => self.on_request(TeleopMode::Stop),
             (_, Event::Request(mode)) => self.on_request(mode),
         }
     }
@@ -217,7 +238,7 @@ impl State {
             State::Legs(LegMotion::Trot(Direction::Forward)) => ControllerMode::TrotForward,
             State::Legs(LegMotion::Trot(Direction::Backward)) => ControllerMode::TrotBackward,
             State::Standing(_) => ControllerMode::Standing,
-            State::Climbing => ControllerMode::Climbing,
+            State::Climbing(_) => ControllerMode::Climbing,
             State::Wheels(WheelMotion::Auto) => ControllerMode::Auto,
             State::Folding(_) => ControllerMode::Folding,
             State::Wheels(WheelMotion::Drive(Direction::Forward)) => ControllerMode::WheelForward,
@@ -230,11 +251,12 @@ impl State {
         }
     }
 
-    /// Whether the wheels carry (or are about to carry) the robot, so the balance law runs.
+    /// Whether the wheels carry (or are about to carry) the robot, so the balance law may run
+    /// (a climb holds them still instead while its feet are down).
     pub fn balancing(self) -> bool {
         matches!(
             self,
-            State::Folding(_) | State::Wheels(_) | State::Standing(_) | State::Climbing
+            State::Folding(_) | State::Wheels(_) | State::Standing(_) | State::Climbing(_)
         )
     }
 }

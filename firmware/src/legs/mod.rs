@@ -1,7 +1,8 @@
 //! The legs: where they attach ([`hips`]), [`kinematics`] (IK/FK of one leg), the poses ([`posture`]: the stance; the fold and
 //! its [`levelling`]), the trot ([`gait`] with its [`phase`] clock, [`foot_trajectory`], the
 //! watch for a swing it cannot finish ([`blocked`]) and the report's [`sine_gait`]), the
-//! quasi-static [`crawl`] (moves for a climb, not used yet), the wheels-first [`climb`] of a
+//! quasi-static [`crawl`] (its feet's loads serve the climb; its moves are not used yet), the
+//! wheels-first [`climb`] of a
 //! step behind, [`smoothing`] of targets,
 //! joint-space [`ramp`]s, the [`transfer`] from the legs onto the wheels and [`support`] (which
 //! feet carry the robot).

@@ -96,7 +96,9 @@ impl Controller {
     }
 
     /// [`Controller::wheels_may_drive`] as far as this tick has found: off the wheels, false
-    /// until the legs' stance has been computed.
+    /// until the legs' stance has been computed. The fold that ends a climb counts as on the
+    /// wheels throughout: the climb has set them on the plateau, and the stance, which takes
+    /// the ground to be one level, would read the robot as standing on its feet.
     pub(super) fn wheels_carry(&self) -> bool {
         matches!(self.state, State::Wheels(_))
             || (self.climbed && matches!(self.state, State::Folding(_)))

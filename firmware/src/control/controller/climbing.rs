@@ -1,6 +1,7 @@
 //! The climb of a step behind ([`crate::legs::climb`]): started where the autonomous mode's
-//! drive stalls against a riser, the feet placed by their drives' loads, then a fold onto the
-//! wheels over the plateau and on in the autonomous mode.
+//! drive stalls against a riser (`Event::StepStall`), the feet placed by their drives' loads,
+//! then a fold onto the wheels over the plateau and on in the autonomous mode (or balancing,
+//! after a stop).
 
 use protocol::{Joints, Leg};
 
@@ -17,16 +18,16 @@ impl Controller {
     /// climb starts (`true`); otherwise the caller faults (a manual drive into a step stops).
     #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
     pub(super) fn climb_on_stall(&mut self, now: Tick) -> bool {
-        let autonomous = self.state == State::Wheels(WheelMotion::Auto);
-        if !autonomous || self.config.climb.is_none() {
+        if self.config.climb.is_none() {
+            return false;
+        }
+        self.apply(Event::StepStall);
+        if !matches!(self.state, State::Climbing(_)) {
             return false;
         }
         let measured =
             PerLeg::from_fn(|leg| LegJoints::from_array(*self.sensors.joint_position_rad.leg(leg)));
         self.climb = Some(Climb::new(now, &self.config.geometry, &measured));
-        self.balance.rebase(0.0);
-        self.balance.hold_here();
-        self.state = State::Climbing;
         true
     }
 
@@ -57,20 +58,23 @@ impl Controller {
             }),
             pitch_rad: self.sensors.attitude.pitch_rad,
         };
+        if self.state == State::Climbing(WheelMotion::Balance) {
+            // Stopped: back to the fold if the legs have not lifted the robot yet.
+            climb.stop(now);
+        }
         climb.tick(&config, self.config.rate, now, &input);
         self.climb = Some(climb);
         match climb.phase() {
             Phase::Ended(end) => {
-                self.step_refused = end != ClimbEnd::Over;
                 self.climb = None;
-                self.apply(Event::PoseReached);
-                if end == ClimbEnd::Over {
-                    // Over the step: the fold onto the wheels, then on in the autonomous mode.
-                    // A climb given up folds and balances (backing on would meet the same
-                    // riser) and reports why.
-                    self.climbed = true;
-                    self.apply(Event::Request(protocol::TeleopMode::Auto));
+                if !matches!(end, ClimbEnd::Over | ClimbEnd::Stopped) {
+                    // Given up: fold and balance (driving on would meet the same riser).
+                    self.apply(Event::StepRefused);
                 }
+                self.apply(Event::PoseReached);
+                // After the transition, which clears both for a new fold.
+                self.climbed = end == ClimbEnd::Over;
+                self.step_refused = !matches!(end, ClimbEnd::Over | ClimbEnd::Stopped);
             }
             _ => {
                 self.climb_pose(&climb);

@@ -13,7 +13,7 @@
 //! 3. **Probe**: they are lowered until each carries a load.
 //! 4. **Rise**: the legs lengthen, lifting the wheels clear of the plateau, each pair to its
 //!    own depth below the hips.
-//! 5. **Crawl**: the body shifts back over its four planted feet, each back foot steps back,
+//! 5. **Shift, Step** (a crawl): the body shifts back over its four planted feet, each back foot steps back,
 //!    and the body shifts back again; the stance is long (back feet well behind their hips on
 //!    the plateau), so that the centre of mass stays inside the other three feet without a
 //!    sway. The front feet do not step: each front step let the body slide forward as far as
@@ -26,9 +26,14 @@
 
 use protocol::Leg;
 
+mod feet;
+
+pub use feet::{foot_of, solve};
+
+use feet::{blend, smoothstep, step_foot};
+
 use crate::legs::crawl::frame::PerLeg;
-use crate::legs::kinematics::{leg_fk, leg_ik, FootTarget, KneeBranch, LegGeometry, LegJoints};
-use crate::limits::JointLimits;
+use crate::legs::kinematics::{LegGeometry, LegJoints};
 use crate::math::{clamp, deg_to_rad};
 use crate::time::{Tick, TickRate};
 
@@ -39,7 +44,8 @@ pub struct ClimbConfig {
     pub reach_x_m: f32,
     /// … and below their hips, m (above a step as high as the legs set a foot on).
     pub reach_depth_m: f32,
-    /// How long the swings to above the ground take, ms.
+    /// How long the swings from the fold (the front feet's to the ground, the back feet's to
+    /// above the plateau) take, ms.
     pub reach_ms: u32,
     /// Where the front feet go down: behind their hips, m.
     pub prop_x_m: f32,
@@ -76,7 +82,7 @@ pub struct ClimbConfig {
     pub step_ms: u32,
     /// How high a stepping foot lifts, m.
     pub lift_m: f32,
-    /// How long the lift, and the last lowering onto the wheels, take, ms.
+    /// How long the lift, a retreat from it and the last lowering onto the wheels take, ms.
     pub rise_ms: u32,
     /// How much the back legs shorten at the end, m, …
     pub lower_back_m: f32,
@@ -125,9 +131,10 @@ impl ClimbConfig {
 /// Why a climb ended.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ClimbEnd {
-    /// The legs stand on both levels and the trot has carried the wheels over the plateau:
-    /// fold onto them.
+    /// The crawl has set the wheels on the plateau: fold onto them.
     Over,
+    /// Stopped before the legs lifted the robot: they are back in the fold, on the wheels.
+    Stopped,
     /// No ground within the legs' reach.
     NoGround,
     /// The step is lower than the wheels climb (no climb needed) or higher than the legs set
@@ -202,6 +209,8 @@ pub struct Climb {
     /// Each foot's target when the rise began, or when the climb began until then: where a
     /// retreat returns to.
     before_rise: PerLeg<Foot>,
+    /// How a retreat ends.
+    retreat_end: ClimbEnd,
 }
 
 impl Climb {
@@ -215,6 +224,17 @@ impl Climb {
             target: feet,
             down: PerLeg::splat(false),
             before_rise: feet,
+            retreat_end: ClimbEnd::StepOutOfRange,
+        }
+    }
+
+    /// A stop at `now`: before the rise the legs go back to the fold (and the climb ends
+    /// [`ClimbEnd::Stopped`]); from the rise on the climb carries on over the step, since
+    /// legs standing a step apart in height have no safe pose short of its end.
+    pub fn stop(&mut self, now: Tick) {
+        if matches!(self.phase, Phase::Prop | Phase::Reach | Phase::Probe) {
+            self.retreat_end = ClimbEnd::Stopped;
+            self.enter(Phase::Retreat, now);
         }
     }
 
@@ -261,14 +281,16 @@ impl Climb {
         t_s: f32,
         input: &ClimbInput,
     ) {
-        let share = t_s / (config.reach_ms as f32 * 1e-3);
+        let share = share_of(t_s, config.reach_ms);
         let goal = Foot {
             x_m: config.prop_x_m,
             depth_m: config.prop_depth_m,
         };
-        if share < 1.0 && !self.down.fl && !self.down.fr {
+        if share < 1.0 {
             for leg in [Leg::Fl, Leg::Fr] {
-                *self.target.get_mut(leg) = blend(self.from.get(leg), goal, share);
+                if !self.down.get(leg) {
+                    *self.target.get_mut(leg) = blend(self.from.get(leg), goal, share);
+                }
             }
         }
         if self.lower([Leg::Fl, Leg::Fr], config, rate, input) {
@@ -277,7 +299,7 @@ impl Climb {
     }
 
     fn reach(&mut self, config: &ClimbConfig, now: Tick, t_s: f32) {
-        let share = t_s / (config.reach_ms as f32 * 1e-3);
+        let share = share_of(t_s, config.reach_ms);
         let goal = Foot {
             x_m: config.reach_x_m,
             depth_m: config.reach_depth_m,
@@ -307,7 +329,7 @@ impl Climb {
     }
 
     fn rise(&mut self, config: &ClimbConfig, now: Tick, t_s: f32, pitch_rad: f32) {
-        let share = clamp(t_s / (config.rise_ms as f32 * 1e-3), 0.0, 1.0);
+        let share = share_of(t_s, config.rise_ms);
         let s = smoothstep(share);
         for leg in Leg::ALL {
             let from = self.from.get(leg);
@@ -334,17 +356,17 @@ impl Climb {
     }
 
     fn retreat(&mut self, config: &ClimbConfig, t_s: f32) {
-        let share = t_s / (config.rise_ms as f32 * 1e-3);
+        let share = share_of(t_s, config.rise_ms);
         for leg in Leg::ALL {
             *self.target.get_mut(leg) = blend(self.from.get(leg), self.before_rise.get(leg), share);
         }
         if share >= 1.0 {
-            self.phase = Phase::Ended(ClimbEnd::StepOutOfRange);
+            self.phase = Phase::Ended(self.retreat_end);
         }
     }
 
     fn shift(&mut self, config: &ClimbConfig, now: Tick, t_s: f32, cycle: u8) {
-        let share = clamp(t_s / (config.shift_ms as f32 * 1e-3), 0.0, 1.0);
+        let share = share_of(t_s, config.shift_ms);
         for leg in Leg::ALL {
             let from = self.from.get(leg);
             *self.target.get_mut(leg) = Foot {
@@ -353,7 +375,7 @@ impl Climb {
             };
         }
         if share >= 1.0 {
-            if cycle + 1 >= config.crawl_cycles {
+            if cycle.saturating_add(1) >= config.crawl_cycles {
                 self.enter(Phase::Lower, now);
             } else {
                 self.enter(Phase::Step { cycle, foot: 0 }, now);
@@ -362,27 +384,28 @@ impl Climb {
     }
 
     fn step(&mut self, config: &ClimbConfig, now: Tick, t_s: f32, cycle: u8, foot: u8) {
-        let Some(&leg) = STEP_ORDER.get(usize::from(foot)) else {
-            self.phase = Phase::Ended(ClimbEnd::Over);
-            return;
-        };
-        let share = clamp(t_s / (config.step_ms as f32 * 1e-3), 0.0, 1.0);
-        *self.target.get_mut(leg) = step_foot(self.from.get(leg), config, share);
+        let share = share_of(t_s, config.step_ms);
+        if let Some(&leg) = STEP_ORDER.get(usize::from(foot)) {
+            *self.target.get_mut(leg) = step_foot(self.from.get(leg), config, share);
+        }
         if share >= 1.0 {
-            let next = if usize::from(foot) + 1 < STEP_ORDER.len() {
+            let next_foot = foot.saturating_add(1);
+            let next = if usize::from(next_foot) < STEP_ORDER.len() {
                 Phase::Step {
                     cycle,
-                    foot: foot + 1,
+                    foot: next_foot,
                 }
             } else {
-                Phase::Shift { cycle: cycle + 1 }
+                Phase::Shift {
+                    cycle: cycle.saturating_add(1),
+                }
             };
             self.enter(next, now);
         }
     }
 
     fn lower_onto_wheels(&mut self, config: &ClimbConfig, t_s: f32) {
-        let share = clamp(t_s / (config.rise_ms as f32 * 1e-3), 0.0, 1.0);
+        let share = share_of(t_s, config.rise_ms);
         for leg in Leg::ALL {
             let from = self.from.get(leg);
             let lower_m = match leg {
@@ -440,63 +463,10 @@ impl Climb {
     }
 }
 
-/// Where `joints` put the foot in its leg's sagittal plane.
-pub fn foot_of(geometry: &LegGeometry, joints: &LegJoints) -> Foot {
-    let foot = leg_fk(geometry, joints);
-    Foot {
-        x_m: foot.x_m,
-        depth_m: -foot.z_m,
-    }
-}
-
-/// Joint angles that put the foot at `foot`, with the foot pitch nearest `pitch_rad` that the
-/// joints reach (tried in 5° steps to either side, up to 90°).
-pub fn solve(
-    geometry: &LegGeometry,
-    limits: &JointLimits,
-    foot: Foot,
-    pitch_rad: f32,
-) -> Option<LegJoints> {
-    const STEPS: i32 = 18;
-    let step_rad = deg_to_rad(5.0);
-    (0..=2 * STEPS).find_map(|i: i32| {
-        let offset: i32 = if i % 2_i32 == 0_i32 {
-            i / 2_i32
-        } else {
-            -(i + 1_i32) / 2_i32
-        };
-        let target = FootTarget {
-            x_m: foot.x_m,
-            y_m: 0.0,
-            z_m: -foot.depth_m,
-            pitch_rad: pitch_rad + offset as f32 * step_rad,
-        };
-        leg_ik(geometry, limits, &target, KneeBranch::Down).ok()
-    })
+/// How far through a span of `ms` milliseconds `t_s` seconds are, 0…1.
+fn share_of(t_s: f32, ms: u32) -> f32 {
+    clamp(t_s / (ms as f32 * 1e-3), 0.0, 1.0)
 }
 
 /// The feet that step in a crawl cycle, in order: the back feet, on the plateau.
 const STEP_ORDER: [Leg; 2] = [Leg::Bl, Leg::Br];
-
-/// A foot stepping `config.crawl_m` back from `from`, `share` of the way through: lifted in
-/// the first third, carried in the second, set down at its depth again in the last.
-fn step_foot(from: Foot, config: &ClimbConfig, share: f32) -> Foot {
-    let third = |k: f32| clamp(3.0 * share - k, 0.0, 1.0);
-    let lift_m = config.lift_m * (smoothstep(third(0.0)) - smoothstep(third(2.0)));
-    Foot {
-        x_m: from.x_m - config.crawl_m * smoothstep(third(1.0)),
-        depth_m: from.depth_m - lift_m,
-    }
-}
-
-fn blend(from: Foot, to: Foot, share: f32) -> Foot {
-    let s = smoothstep(clamp(share, 0.0, 1.0));
-    Foot {
-        x_m: from.x_m + (to.x_m - from.x_m) * s,
-        depth_m: from.depth_m + (to.depth_m - from.depth_m) * s,
-    }
-}
-
-fn smoothstep(s: f32) -> f32 {
-    s * s * (3.0 - 2.0 * s)
-}
