@@ -8,6 +8,7 @@
 //! `cargo test --release -p sim-host --test climb -- --nocapture` prints each robot's figures.
 
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use firmware::control::fsm::{State, WheelMotion};
 use host_can::fault_plan::Faults;
@@ -28,6 +29,10 @@ const END_S: f64 = 25.0;
 
 /// Height of the torso's origin over the ground balancing on the wheels, m.
 const ON_WHEELS_M: f64 = 0.27;
+
+/// Runs so far in this process: each writes its scene to a directory of its own (the tests
+/// run in parallel, and two writing one file read it half-written).
+static RUNS: AtomicU64 = AtomicU64::new(0);
 
 /// What one trial did.
 #[derive(Debug)]
@@ -80,7 +85,7 @@ fn climb_step(seed: u64, mode: TeleopMode, height_m: f64, distance_m: f64, end_s
     });
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("climb")
-        .join(format!("{height_m}-{seed}"));
+        .join(format!("{seed}-{}", RUNS.fetch_add(1, Ordering::Relaxed)));
     let model = mjcf::write(&scene, Path::new(DEFAULT_MODEL), &dir).unwrap();
     let plan = vec![PlanStep::at(0.0, TeleopMode::Fold), PlanStep::at(4.0, mode)];
     let faults = Faults::default();

@@ -7,6 +7,7 @@
 //! `cargo test --release -p sim-host --test climb_stops -- --nocapture` prints the figures.
 
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use firmware::control::fsm::{State, WheelMotion};
 use host_can::fault_plan::Faults;
@@ -25,6 +26,10 @@ const RISER_M: f64 = 1.2;
 const ON_WHEELS_M: f64 = 0.27;
 /// How long after the stop the robot has to end balancing, s.
 const SETTLE_S: f64 = 20.0;
+
+/// Runs so far in this process: each writes its scene to a directory of its own (the tests
+/// run in parallel, and two writing one file read it half-written).
+static RUNS: AtomicU64 = AtomicU64::new(0);
 
 /// What a run did.
 #[derive(Debug)]
@@ -47,7 +52,7 @@ fn run(seed: u64, stop_s: Option<f64>, latch_s: Option<f64>, end_s: f64) -> Run 
     });
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("climb_stops")
-        .join(seed.to_string());
+        .join(format!("{seed}-{}", RUNS.fetch_add(1, Ordering::Relaxed)));
     let model = mjcf::write(&scene, Path::new(DEFAULT_MODEL), &dir).unwrap();
     let mut plan = vec![
         PlanStep::at(0.0, TeleopMode::Fold),
