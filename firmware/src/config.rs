@@ -94,8 +94,8 @@ pub struct Config {
     pub runaway: RunawayConfig,
     /// When the trot counts as blocked by what it cannot step over.
     pub blocked: BlockedConfig,
-    /// How a backward drive stalled by a step behind climbs it ([`crate::legs::climb`];
-    /// `None`: the stall is a fault).
+    /// How the autonomous mode climbs a step its wheels stall against
+    /// ([`crate::legs::climb`]; `None`: the stall is a fault, as in the manual modes).
     pub climb: Option<ClimbConfig>,
 }
 

@@ -127,6 +127,13 @@ pub fn atan2(y: f32, x: f32) -> f32 {
     libm::atan2f(y, x)
 }
 
+/// The smooth step `3s² − 2s³` of `s` in 0…1: from 0 to 1 with no speed at either end, the
+/// blend of a move that starts and ends at rest.
+#[inline]
+pub fn smoothstep(s: f32) -> f32 {
+    s * s * (3.0 - 2.0 * s)
+}
+
 /// `x` clamped to `lo…hi`; NaN stays NaN so callers can detect it.
 #[inline]
 pub fn clamp(x: f32, lo: f32, hi: f32) -> f32 {

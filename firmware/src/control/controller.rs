@@ -335,7 +335,7 @@ impl Controller {
     fn wheel_torques(&mut self, now: Tick, dt_s: f32) -> [f32; 2] {
         // A climb holds the wheels from its first tick: balancing, the robot rolled off the
         // riser as the legs moved.
-        let climbing = self.climb.is_some();
+        let climbing = matches!(self.state, State::Climbing(_));
         if self.stop.is_some_and(|stop| stop.holds_wheels()) || self.folding_on_feet() || climbing {
             return self.hold_wheels(dt_s);
         }

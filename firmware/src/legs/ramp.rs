@@ -72,7 +72,7 @@ impl Ramp {
         let c = crate::math::clamp(slow, 0.0, 1.0);
         let d = self.progress(now) - 0.5;
         let s = 0.5 + d * (1.0 - c) + 4.0 * c * d * d * d;
-        let blend = s * s * (3.0 - 2.0 * s);
+        let blend = crate::math::smoothstep(s);
         let mut pose = self.from;
         for (joint, goal) in pose.iter_mut().zip(self.to.iter()) {
             *joint += blend * (goal - *joint);

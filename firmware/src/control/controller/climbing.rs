@@ -67,14 +67,15 @@ impl Controller {
         match climb.phase() {
             Phase::Ended(end) => {
                 self.climb = None;
-                if !matches!(end, ClimbEnd::Over | ClimbEnd::Stopped) {
+                let refused = !matches!(end, ClimbEnd::Over | ClimbEnd::Stopped);
+                if refused {
                     // Given up: fold and balance (driving on would meet the same riser).
                     self.apply(Event::StepRefused);
                 }
                 self.apply(Event::PoseReached);
                 // After the transition, which clears both for a new fold.
                 self.climbed = end == ClimbEnd::Over;
-                self.step_refused = !matches!(end, ClimbEnd::Over | ClimbEnd::Stopped);
+                self.step_refused = refused;
             }
             _ => {
                 self.climb_pose(&climb);

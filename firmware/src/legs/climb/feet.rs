@@ -4,7 +4,7 @@
 use super::{ClimbConfig, Foot};
 use crate::legs::kinematics::{leg_fk, leg_ik, FootTarget, KneeBranch, LegGeometry, LegJoints};
 use crate::limits::JointLimits;
-use crate::math::{clamp, deg_to_rad};
+use crate::math::{clamp, deg_to_rad, smoothstep};
 
 /// Where `joints` put the foot in its leg's sagittal plane.
 pub fn foot_of(geometry: &LegGeometry, joints: &LegJoints) -> Foot {
@@ -58,8 +58,4 @@ pub(super) fn blend(from: Foot, to: Foot, share: f32) -> Foot {
         x_m: from.x_m + (to.x_m - from.x_m) * s,
         depth_m: from.depth_m + (to.depth_m - from.depth_m) * s,
     }
-}
-
-pub(super) fn smoothstep(s: f32) -> f32 {
-    s * s * (3.0 - 2.0 * s)
 }

@@ -30,11 +30,12 @@ mod feet;
 
 pub use feet::{foot_of, solve};
 
-use feet::{blend, smoothstep, step_foot};
+use feet::{blend, step_foot};
 
 use crate::legs::crawl::frame::PerLeg;
+use crate::legs::hips::HipLayout;
 use crate::legs::kinematics::{LegGeometry, LegJoints};
-use crate::math::{clamp, deg_to_rad};
+use crate::math::{clamp, deg_to_rad, smoothstep};
 use crate::time::{Tick, TickRate};
 
 /// How the climb places the feet and how far it crawls.
@@ -63,9 +64,9 @@ pub struct ClimbConfig {
     pub touchdown_lag_m: f32,
     /// How much deeper than where it touched a foot is then held, m (its share of the weight).
     pub preload_m: f32,
-    /// Half the distance between the front and back hips, m (the body's pitch moves each pair
-    /// up or down by it).
-    pub hip_half_span_m: f32,
+    /// Where the hips are: the body's pitch moves each pair up or down by their distance
+    /// from the torso's centre.
+    pub hips: HipLayout,
     /// Where the front feet stand after the rise, m below their hips.
     pub front_depth_m: f32,
     /// Where the back feet stand after the rise, m below their hips: as deep as the legs
@@ -111,7 +112,7 @@ impl ClimbConfig {
         touchdown_n: 15.0,
         touchdown_lag_m: 0.01,
         preload_m: 0.01,
-        hip_half_span_m: 0.22,
+        hips: HipLayout::ROBOT,
         front_depth_m: 0.36,
         back_depth_m: 0.31,
         crawl_m: 0.09,
@@ -253,7 +254,7 @@ impl Climb {
     pub fn step_height_m(&self, config: &ClimbConfig, pitch_rad: f32) -> f32 {
         let mean = |a: Leg, b: Leg| 0.5 * (self.target.get(a).depth_m + self.target.get(b).depth_m);
         mean(Leg::Fl, Leg::Fr) - mean(Leg::Bl, Leg::Br)
-            + 2.0 * config.hip_half_span_m * crate::math::sin(pitch_rad)
+            + 2.0 * config.hips.x_m * crate::math::sin(pitch_rad)
     }
 
     /// One tick at `now` with what the drives report (`input`).
