@@ -2,6 +2,8 @@
 //! and a plan of operator modes with one measured segment per step.
 #![allow(dead_code)] // each test file uses a part
 
+pub mod climb;
+
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 

@@ -1,0 +1,131 @@
+//! What the climb tests share: one robot of the campaign, in a plan, toward a step behind it,
+//! with the controller's states, its falls and its tilt recorded.
+
+use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use firmware::control::fsm::State;
+use host_can::fault_plan::Faults;
+use protocol::{AnyMessage, EStop, NodeId, Session, TeleopMode, TEST_KEY};
+use sim_host::campaign::draw::Draws;
+use sim_host::campaign::Drives;
+use sim_host::faults::rig::Rig;
+use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::scene::{mjcf, Scene, Step};
+use teleop_core::scripted::PlanStep;
+
+/// Height of the torso's origin over the ground balancing on the wheels, m.
+pub const ON_WHEELS_M: f64 = 0.27;
+
+/// How deep the plateau is, m: room to drive on after a climb.
+const PLATEAU_M: f64 = 6.0;
+
+/// When the robot, folded from 0 s, is sent its mode, s.
+pub const MODE_AT_S: f64 = 4.0;
+
+/// Runs so far in this process: each writes its scene to a directory of its own (the tests
+/// run in parallel, and two writing one file read it half-written).
+static RUNS: AtomicU64 = AtomicU64::new(0);
+
+/// Where the step stands: `height_m` high, its riser `distance_m` behind the start.
+#[derive(Debug, Clone, Copy)]
+pub struct StepBehind {
+    /// Riser height, m.
+    pub height_m: f64,
+    /// How far behind the start the riser stands, m.
+    pub distance_m: f64,
+}
+
+/// What one trial did.
+#[derive(Debug)]
+pub struct Trial {
+    /// When it first fell (tilt past 45° or the torso on the ground), s, and the controller's
+    /// state then.
+    pub fell_at: Option<(f64, Option<State>)>,
+    /// The controller's states in order, with when each began, s.
+    pub states: Vec<(f64, State)>,
+    /// How far past the riser the axle ended, onto the plateau, m.
+    pub onto_plateau_m: f64,
+    /// The torso's height at the end, m.
+    pub torso_z_m: f64,
+    /// Largest tilt after the mode was sent, degrees.
+    pub max_tilt_deg: f64,
+}
+
+impl Trial {
+    /// The controller's state at the end.
+    pub fn last(&self) -> Option<State> {
+        self.states.last().map(|&(_, s)| s)
+    }
+
+    /// When its first climb began, s.
+    pub fn climb_start_s(&self) -> Option<f64> {
+        self.states
+            .iter()
+            .find(|(_, s)| matches!(s, State::Climbing(_)))
+            .map(|&(t, _)| t)
+    }
+}
+
+/// Runs robot `seed` of the campaign (rated drives) toward `step`: folded at 0 s, `mode` at
+/// [`MODE_AT_S`], the operator's STOP at `stop_s` and an E-stop latched at `latch_s` if any;
+/// until `end_s`.
+pub fn run(
+    seed: u64,
+    step: StepBehind,
+    mode: TeleopMode,
+    (stop_s, latch_s): (Option<f64>, Option<f64>),
+    end_s: f64,
+) -> Trial {
+    let riser_x_m = -step.distance_m;
+    let scene = Scene::Step(Step {
+        height_m: step.height_m,
+        riser_x_m: riser_x_m - PLATEAU_M,
+        depth_m: PLATEAU_M,
+    });
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("climb")
+        .join(format!("{seed}-{}", RUNS.fetch_add(1, Ordering::Relaxed)));
+    let model = mjcf::write(&scene, Path::new(DEFAULT_MODEL), &dir).unwrap();
+    let mut plan = vec![
+        PlanStep::at(0.0, TeleopMode::Fold),
+        PlanStep::at(MODE_AT_S, mode),
+    ];
+    plan.extend(stop_s.map(|at_s| PlanStep::at(at_s, TeleopMode::Stop)));
+    let faults = Faults::default();
+    let plant = Draws::of(seed).plant(Drives::Rated.ratings());
+    let mut rig = Rig::with_plant(&model, plan, &faults, &faults, plant).unwrap();
+    let (mut fell_at, mut states, mut max_tilt_deg) = (None, Vec::new(), 0.0_f64);
+    let mut latch_s = latch_s;
+    while rig.time_s() < end_s {
+        if latch_s.is_some_and(|at_s| rig.time_s() >= at_s) {
+            latch_s = None;
+            // Bound to no session, as an E-stop panel's constant frame.
+            let latch = AnyMessage::EStop(EStop::latch(NodeId::Tool))
+                .encode(&Session::unjoined(TEST_KEY), 0)
+                .unwrap();
+            rig.tool_send(&latch).unwrap();
+        }
+        rig.step().unwrap();
+        let record = rig.records().last().unwrap();
+        if record.fallen() && fell_at.is_none() {
+            fell_at = Some((rig.time_s(), record.state));
+        }
+        if let Some(state) = record.state {
+            if states.last().is_none_or(|&(_, last)| last != state) {
+                states.push((rig.time_s(), state));
+            }
+        }
+        if rig.time_s() > MODE_AT_S {
+            max_tilt_deg = max_tilt_deg.max(record.tilt_deg);
+        }
+    }
+    let torso = rig.sim().physics().torso();
+    Trial {
+        fell_at,
+        states,
+        onto_plateau_m: riser_x_m - torso.pos_m[0],
+        torso_z_m: torso.pos_m[2],
+        max_tilt_deg,
+    }
+}
