@@ -17,6 +17,7 @@ use crate::limits::JointLimits;
 use crate::time::TickRate;
 use crate::wheels::balance::{BalanceConfig, BalanceGains, BalanceModel};
 use crate::wheels::runaway::RunawayConfig;
+use crate::wheels::traction::TractionConfig;
 use crate::wheels::wheel::SpeedLoopGains;
 
 /// Controller configuration.
@@ -92,6 +93,8 @@ pub struct Config {
     pub stop: StopConfig,
     /// When the wheels count as stalled or running away.
     pub runaway: RunawayConfig,
+    /// When the wheels count as off the ground, and how they hold meanwhile.
+    pub traction: TractionConfig,
     /// When the trot counts as blocked by what it cannot step over.
     pub blocked: BlockedConfig,
     /// How the autonomous mode climbs a step its wheels stall against
@@ -146,6 +149,7 @@ impl Config {
         attitude: EstimatorConfig::ROBOT,
         stop: StopConfig::ROBOT,
         runaway: RunawayConfig::ROBOT,
+        traction: TractionConfig::ROBOT,
         blocked: BlockedConfig::ROBOT,
         climb: Some(ClimbConfig::ROBOT),
     };

@@ -8,7 +8,7 @@
 
 mod common;
 
-use common::climb::{run, StepBehind, Trial, ON_WHEELS_M};
+use common::climb::{run, StepBehind, Trial, LONG_PLATEAU_M, ON_WHEELS_M};
 use firmware::control::fsm::{State, WheelMotion};
 use protocol::TeleopMode;
 
@@ -16,6 +16,7 @@ use protocol::TeleopMode;
 const STEP: StepBehind = StepBehind {
     height_m: 0.06,
     distance_m: 1.2,
+    plateau_m: LONG_PLATEAU_M,
 };
 /// How long after the stop the robot has to end balancing, s.
 const SETTLE_S: f64 = 20.0;

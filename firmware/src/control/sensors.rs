@@ -83,18 +83,20 @@ impl Sensors {
     }
 
     /// Runs this tick's IMU sample, if any, through the attitude estimator (configured as
-    /// `config`) with the torso's `motion`. Not inlined: the filter's temporaries then do not
-    /// add to the control step's frame (56 bytes of peak stack on the MCU).
+    /// `config`) with the torso's `motion`, and returns its specific force's magnitude, m/s²
+    /// (`None`: no sample this tick). Not inlined: the filter's temporaries then do not add to
+    /// the control step's frame (56 bytes of peak stack on the MCU).
     #[inline(never)]
-    pub fn estimate(&mut self, config: &EstimatorConfig, motion: Motion) {
-        if let Some((tick, imu)) = self.imu_sample.take() {
-            let gyro = imu.angular_rate.map(|w| w.si());
-            let accel = imu.acceleration.map(|a| a.si());
-            if self.estimator.update(config, tick, gyro, accel, motion) {
-                self.attitude = self.estimator.attitude();
-                self.angular_rate_rad_s = self.estimator.rate_rad_s();
-            }
+    pub fn estimate(&mut self, config: &EstimatorConfig, motion: Motion) -> Option<f32> {
+        let (tick, imu) = self.imu_sample.take()?;
+        let gyro = imu.angular_rate.map(|w| w.si());
+        let accel = imu.acceleration.map(|a| a.si());
+        if self.estimator.update(config, tick, gyro, accel, motion) {
+            self.attitude = self.estimator.attitude();
+            self.angular_rate_rad_s = self.estimator.rate_rad_s();
         }
+        let [x, y, z] = accel;
+        Some(crate::math::sqrt(x * x + y * y + z * z))
     }
 
     /// Whether there is an attitude to act on: the IMU talks and its estimator has started

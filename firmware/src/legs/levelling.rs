@@ -49,6 +49,12 @@ pub struct FoldFamily {
     pub back_forward: LegJoints,
     /// The shift at which the back legs are at [`FoldFamily::back_under`] (in (0, 1)).
     pub back_under_at: f32,
+    /// Front legs riding in the autonomous mode (the left leg's; the right one mirrors its
+    /// abduction): knees at their stop, thighs and shanks as high as the joints carry them
+    /// and spread outward (still under the torso), so that they clear the plateau's edge when
+    /// the wheels roll off a step down back first. The tucked fold hangs its knees 6.5 cm
+    /// over the ground; this pose, 12 cm.
+    pub front_clear: LegJoints,
 }
 
 const fn leg(hip_pitch_deg: f32, knee_deg: f32, ankle_deg: f32) -> LegJoints {
@@ -71,6 +77,10 @@ impl FoldFamily {
         back_under: leg(0.0, -100.0, -40.0),
         back_forward: leg(45.0, -100.0, -40.0),
         back_under_at: 0.6,
+        front_clear: LegJoints {
+            hip_abduction_rad: deg_to_rad(30.0),
+            ..leg(20.0, -110.0, -40.0)
+        },
     };
 
     /// The pose of all four legs at `shift` (clamped to −1…1; NaN counts as 0).

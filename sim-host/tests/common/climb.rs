@@ -17,10 +17,10 @@ use teleop_core::scripted::PlanStep;
 /// Height of the torso's origin over the ground balancing on the wheels, m.
 pub const ON_WHEELS_M: f64 = 0.27;
 
-/// How deep the plateau is, m: room to drive on after a climb.
-const PLATEAU_M: f64 = 6.0;
+/// How deep a plateau is that the robot only climbs onto, m: room to drive on after a climb.
+pub const LONG_PLATEAU_M: f64 = 6.0;
 
-/// When the robot, folded from 0 s, is sent its mode, s.
+/// When the robot, folded from 0 s as in the campaign's scenarios, is sent its mode, s.
 pub const MODE_AT_S: f64 = 4.0;
 
 /// Runs so far in this process: each writes its scene to a directory of its own (the tests
@@ -34,6 +34,8 @@ pub struct StepBehind {
     pub height_m: f64,
     /// How far behind the start the riser stands, m.
     pub distance_m: f64,
+    /// How deep the plateau is, m: its far edge is a step down as high.
+    pub plateau_m: f64,
 }
 
 /// What one trial did.
@@ -50,6 +52,12 @@ pub struct Trial {
     pub torso_z_m: f64,
     /// Largest tilt after the mode was sent, degrees.
     pub max_tilt_deg: f64,
+    /// Largest roll after the mode was sent, degrees.
+    pub max_roll_deg: f64,
+    /// Each part of the robot that touched the step, with when it first did, s.
+    pub contacts: Vec<(f64, String)>,
+    /// Where the torso was along the path at the end, m (the start at 0, the step behind).
+    pub torso_x_m: f64,
 }
 
 impl Trial {
@@ -77,25 +85,48 @@ pub fn run(
     (stop_s, latch_s): (Option<f64>, Option<f64>),
     end_s: f64,
 ) -> Trial {
-    let riser_x_m = -step.distance_m;
-    let scene = Scene::Step(Step {
-        height_m: step.height_m,
-        riser_x_m: riser_x_m - PLATEAU_M,
-        depth_m: PLATEAU_M,
-    });
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
-        .join("climb")
-        .join(format!("{seed}-{}", RUNS.fetch_add(1, Ordering::Relaxed)));
-    let model = mjcf::write(&scene, Path::new(DEFAULT_MODEL), &dir).unwrap();
     let mut plan = vec![
         PlanStep::at(0.0, TeleopMode::Fold),
         PlanStep::at(MODE_AT_S, mode),
     ];
     plan.extend(stop_s.map(|at_s| PlanStep::at(at_s, TeleopMode::Stop)));
+    run_plan(seed, step, plan, latch_s, end_s)
+}
+
+/// As [`run`] in the autonomous mode without stops, but the robot first stands still for
+/// 1.5 s and is folded from there, the mode sent 4 s later.
+pub fn run_standing_first(seed: u64, step: StepBehind, end_s: f64) -> Trial {
+    let plan = vec![
+        PlanStep::at(0.0, TeleopMode::Stand),
+        PlanStep::at(1.5, TeleopMode::Fold),
+        PlanStep::at(1.5 + MODE_AT_S, TeleopMode::Auto),
+    ];
+    run_plan(seed, step, plan, None, end_s)
+}
+
+fn run_plan(
+    seed: u64,
+    step: StepBehind,
+    plan: Vec<PlanStep>,
+    latch_s: Option<f64>,
+    end_s: f64,
+) -> Trial {
+    let riser_x_m = -step.distance_m;
+    let scene = Scene::Step(Step {
+        height_m: step.height_m,
+        riser_x_m: riser_x_m - step.plateau_m,
+        depth_m: step.plateau_m,
+    });
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join("climb")
+        .join(format!("{seed}-{}", RUNS.fetch_add(1, Ordering::Relaxed)));
+    let model = mjcf::write(&scene, Path::new(DEFAULT_MODEL), &dir).unwrap();
     let faults = Faults::default();
     let plant = Draws::of(seed).plant(Drives::Rated.ratings());
     let mut rig = Rig::with_plant(&model, plan, &faults, &faults, plant).unwrap();
     let (mut fell_at, mut states, mut max_tilt_deg) = (None, Vec::new(), 0.0_f64);
+    let mut max_roll_deg = 0.0_f64;
+    let mut contacts: Vec<(f64, String)> = Vec::new();
     let mut latch_s = latch_s;
     while rig.time_s() < end_s {
         if latch_s.is_some_and(|at_s| rig.time_s() >= at_s) {
@@ -116,8 +147,17 @@ pub fn run(
                 states.push((rig.time_s(), state));
             }
         }
+        let physics = rig.sim().physics();
         if rig.time_s() > MODE_AT_S {
             max_tilt_deg = max_tilt_deg.max(record.tilt_deg);
+            let [roll_rad, _, _] = physics.torso().rpy_rad();
+            max_roll_deg = max_roll_deg.max(roll_rad.to_degrees().abs());
+        }
+        for (_, part) in physics.obstacle_contacts() {
+            let name = physics.geom_name(part);
+            if contacts.iter().all(|(_, seen)| seen != name) {
+                contacts.push((rig.time_s(), name.to_owned()));
+            }
         }
     }
     let torso = rig.sim().physics().torso();
@@ -127,5 +167,8 @@ pub fn run(
         onto_plateau_m: riser_x_m - torso.pos_m[0],
         torso_z_m: torso.pos_m[2],
         max_tilt_deg,
+        max_roll_deg,
+        contacts,
+        torso_x_m: torso.pos_m[0],
     }
 }

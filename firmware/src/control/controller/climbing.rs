@@ -75,6 +75,7 @@ impl Controller {
                 self.apply(Event::PoseReached);
                 // After the transition, which clears both for a new fold.
                 self.climbed = end == ClimbEnd::Over;
+                self.on_top |= self.climbed;
                 self.step_refused = refused;
             }
             _ => {

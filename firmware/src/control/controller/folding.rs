@@ -1,11 +1,12 @@
 //! The fold from the legs onto the wheels ([`crate::legs::transfer`]), the wheels' torque
 //! ramped in as they take the robot, and when a transition between legs and wheels is over.
 
-use protocol::Joints;
+use protocol::{Joints, Leg};
 
 use super::Controller;
 use crate::control::fsm::{State, WheelMotion};
 use crate::control::safety::clamp_leg_targets;
+use crate::legs::kinematics::LegJoints;
 use crate::legs::transfer::Transfer;
 use crate::time::Tick;
 
@@ -30,7 +31,8 @@ impl Controller {
     /// This tick of the fold: started on the first tick of the transition from where the legs
     /// are, through the stance at `depth_m`.
     pub(super) fn fold_step(&mut self, now: Tick, depth_m: f32) {
-        self.goal_rad = self.fold_rad();
+        let fold_goal_rad = self.fold_goal_rad();
+        self.goal_rad = fold_goal_rad;
         let mut transfer = match self.transfer {
             Some(running) => running,
             None => {
@@ -48,7 +50,7 @@ impl Controller {
                     }
                     Err(_) => self.legs_rad,
                 };
-                let (from, goal) = (self.legs_rad, self.fold_rad());
+                let (from, goal) = (self.legs_rad, fold_goal_rad);
                 Transfer::new(
                     config.transfer,
                     config.rate,
@@ -246,6 +248,37 @@ impl Controller {
     #[inline(never)] // As `level`.
     pub(super) fn fold_rad(&self) -> Joints<f32> {
         self.within_limits(self.levelling.pose(&self.config.levelling))
+    }
+
+    /// Where a fold tucks the legs: the fold pose; after a climb with the front legs clear
+    /// ([`Controller::with_front_clear`]): tucked under the torso, they dragged on the plateau
+    /// as the balance law caught the robot tipping off its back feet, and the robot ran away.
+    fn fold_goal_rad(&self) -> Joints<f32> {
+        let fold_rad = self.fold_rad();
+        if self.climbed {
+            self.with_front_clear(fold_rad)
+        } else {
+            fold_rad
+        }
+    }
+
+    /// `pose` with the front legs as the autonomous mode carries them: high, clear of a
+    /// plateau's edge the wheels roll off ([`crate::legs::levelling::FoldFamily::front_clear`]).
+    pub(super) fn with_front_clear(&self, pose: Joints<f32>) -> Joints<f32> {
+        let left = self.config.levelling.family.front_clear;
+        let right = LegJoints {
+            hip_abduction_rad: -left.hip_abduction_rad,
+            ..left
+        };
+        let clear = self.within_limits(Joints::from_leg_fn(|leg| match leg {
+            Leg::Fr | Leg::Br => right.to_array(),
+            Leg::Fl | Leg::Bl => left.to_array(),
+        }));
+        let mut pose = pose;
+        for leg in [Leg::Fl, Leg::Fr] {
+            *pose.leg_mut(leg) = *clear.leg(leg);
+        }
+        pose
     }
 
     /// `pose` clamped into the joint ranges.

@@ -10,6 +10,10 @@ use crate::wheels::balance::BalanceInput;
 use crate::wheels::runaway::RunawayInput;
 use crate::wheels::wheel::mix;
 
+/// How long after a drop's hold a stall is not taken for a riser, ms (a robot that landed
+/// hard off a plateau tripped the stall watch 1.3 s later and began to climb at the edge).
+const LANDING_NO_CLIMB_MS: u32 = 2_000;
+
 impl Controller {
     /// This tick's wheel torques `[left, right]` from the balance law and the turn loop (none
     /// while the attitude is unknown).
@@ -29,18 +33,41 @@ impl Controller {
             },
             dt_s,
         );
+        let mut common = common;
         if matches!(self.state, State::Wheels(_)) {
             let input = RunawayInput {
                 ground_speed_m_s: self.ground_speed_m_s(),
                 velocity_ref_m_s: self.balance.velocity_ref_m_s(),
+                // What the law asks for, held for a fall or not: a fall's hold is short, and
+                // a wheel that cannot do what the law asks for longer is what is watched.
                 torque_nm: common,
                 torque_limit_nm: self.config.balance.torque_limit_nm,
             };
             if let Some(cause) = self.runaway.update(&self.config.runaway, &input) {
-                let climbs = cause == protocol::FaultFlags::WHEEL_STALL && self.climb_on_stall(now);
+                // A stall just after a drop is the landing, not a riser: stop, do not climb.
+                let landed = self
+                    .traction
+                    .fell_within(self.config.rate.ticks_from_ms(LANDING_NO_CLIMB_MS));
+                let climbs = cause == protocol::FaultFlags::WHEEL_STALL
+                    && !landed
+                    && self.climb_on_stall(now);
                 if !climbs {
                     self.wheel_fault_stop(now, cause, input.ground_speed_m_s);
                 }
+            }
+            // Only the autonomous mode drives off edges by itself. In a collision the robot
+            // also bounces light for a moment, and holding the wheels at the reference then
+            // hid the deceleration the stall watch looks for (W into a step stopped 0.15 s
+            // later, past the half second the stall acceptance allows).
+            let auto = self.state == State::Wheels(WheelMotion::Auto);
+            let hold = self.traction.update(
+                &self.config.traction,
+                self.config.rate,
+                self.sensors.mean_wheel_rate_rad_s(),
+                input.velocity_ref_m_s / self.config.balance.wheel_radius_m,
+            );
+            if let (true, Some(hold_nm)) = (auto, hold) {
+                common = hold_nm;
             }
         }
         self.turn_ref_rad_s = crate::math::toward(

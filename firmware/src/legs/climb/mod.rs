@@ -97,6 +97,11 @@ pub struct ClimbConfig {
     /// A body pitched further nose down than this when the back feet are down is not lifted,
     /// rad.
     pub pitch_max_rad: f32,
+    /// A body pitched further than this either way once the legs have set it down is not on
+    /// its wheels on the plateau, rad: the crawl did not carry it over (the wheels stand on
+    /// the plateau pitched a few degrees nose up; a robot whose wheels came down before the
+    /// riser stood 26–28° nose down on its back feet, and climbed again).
+    pub over_pitch_max_rad: f32,
 }
 
 impl ClimbConfig {
@@ -126,6 +131,7 @@ impl ClimbConfig {
         step_min_m: 0.03,
         step_max_m: 0.09,
         pitch_max_rad: deg_to_rad(12.0),
+        over_pitch_max_rad: deg_to_rad(15.0),
     };
 }
 
@@ -141,6 +147,8 @@ pub enum ClimbEnd {
     /// The step is lower than the wheels climb (no climb needed) or higher than the legs set
     /// a foot on.
     StepOutOfRange,
+    /// The legs have set the body down, but not on its wheels on the plateau.
+    NotOver,
 }
 
 /// What the climb reads from the drives each tick.
@@ -269,7 +277,7 @@ impl Climb {
             Phase::Retreat => self.retreat(config, t_s),
             Phase::Shift { cycle } => self.shift(config, now, t_s, cycle),
             Phase::Step { cycle, foot } => self.step(config, now, t_s, cycle, foot),
-            Phase::Lower => self.lower_onto_wheels(config, t_s),
+            Phase::Lower => self.lower_onto_wheels(config, t_s, pitch_rad),
             Phase::Ended(_) => {}
         }
     }
@@ -405,7 +413,7 @@ impl Climb {
         }
     }
 
-    fn lower_onto_wheels(&mut self, config: &ClimbConfig, t_s: f32) {
+    fn lower_onto_wheels(&mut self, config: &ClimbConfig, t_s: f32, pitch_rad: f32) {
         let share = share_of(t_s, config.rise_ms);
         for leg in Leg::ALL {
             let from = self.from.get(leg);
@@ -419,7 +427,12 @@ impl Climb {
             };
         }
         if share >= 1.0 {
-            self.phase = Phase::Ended(ClimbEnd::Over);
+            let over = pitch_rad.abs() <= config.over_pitch_max_rad;
+            self.phase = Phase::Ended(if over {
+                ClimbEnd::Over
+            } else {
+                ClimbEnd::NotOver
+            });
         }
     }
 

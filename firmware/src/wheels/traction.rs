@@ -1,0 +1,180 @@
+//! Traction: whether the wheels carry the robot, or it is falling.
+//!
+//! Backing off a plateau's edge, the wheels pivot over it and the robot drops for a tenth of a
+//! second. The balance law, seeing the torso pitch as the robot tips over the edge, drives the
+//! wheels at its limit, and with nothing to push against they spin up (from 5 to 24 rad/s
+//! within 80 ms, measured at 6 cm): the robot lands on wheels turning four times faster than
+//! it moves and is thrown into a runaway. A falling robot feels no weight: the accelerometer's
+//! specific force drops toward zero (on the wheels it reads about g, whatever the law does).
+//! So while the specific force stays well under g the wheels turn at the rate the speed
+//! reference asks for, and the robot lands rolling as fast as it moves; the balance law takes
+//! over again a moment after the weight is back.
+//!
+//! A fall is bounded: a hold longer than a step's drop takes ([`TractionConfig::max_hold_ms`])
+//! gives the wheels back to the law, so a sensor reading low cannot switch the balance off.
+
+use crate::time::TickRate;
+
+/// When the robot counts as falling and how the wheels hold meanwhile.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TractionConfig {
+    /// Specific force below this, m/s², …
+    pub falling_m_s2: f32,
+    /// … on this many IMU samples in a row is a fall.
+    pub falling_samples: u8,
+    /// The wheels hold until the specific force has been back over
+    /// [`TractionConfig::falling_m_s2`] for this long, ms (the landing).
+    pub landing_ms: u32,
+    /// … and for no longer than this in all, ms (a 10 cm drop takes 140 ms).
+    pub max_hold_ms: u32,
+    /// The hold's torque per rad/s off the rate asked for, N·m·s/rad (both wheels together).
+    pub hold_nm_per_rad_s: f32,
+}
+
+impl TractionConfig {
+    /// The robot.
+    pub const ROBOT: Self = Self {
+        falling_m_s2: 4.0,
+        falling_samples: 2,
+        landing_ms: 40,
+        max_hold_ms: 300,
+        hold_nm_per_rad_s: 1.0,
+    };
+}
+
+/// The fall watch's state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Traction {
+    /// IMU samples in a row under the falling threshold.
+    light_samples: u8,
+    /// Ticks held so far in this fall.
+    held_ticks: u32,
+    /// Ticks left of the landing's hold.
+    landing_left: u32,
+    /// Ticks since the last hold ended (saturating; `u32::MAX` before the first).
+    since_hold: u32,
+}
+
+impl Traction {
+    /// Carried, nothing seen.
+    pub const fn new() -> Self {
+        Self {
+            light_samples: 0,
+            held_ticks: 0,
+            landing_left: 0,
+            since_hold: u32::MAX,
+        }
+    }
+
+    /// Forgets what it saw (the wheels stopped driving).
+    pub fn reset(&mut self) {
+        *self = Self::new();
+    }
+
+    /// Takes this tick's IMU sample's specific force, m/s² (its magnitude).
+    pub fn record(&mut self, config: &TractionConfig, specific_force_m_s2: f32) {
+        self.light_samples = if specific_force_m_s2 < config.falling_m_s2 {
+            self.light_samples.saturating_add(1)
+        } else {
+            0
+        };
+    }
+
+    /// One tick: the common torque that turns the wheels at `hold_rate_rad_s` (the rate the
+    /// speed reference asks for) from `rate_rad_s` (their mean rate) while the robot falls and
+    /// lands, N·m; `None` while the wheels carry it.
+    pub fn update(
+        &mut self,
+        config: &TractionConfig,
+        rate: TickRate,
+        rate_rad_s: f32,
+        hold_rate_rad_s: f32,
+    ) -> Option<f32> {
+        let falling = self.light_samples >= config.falling_samples;
+        if !falling && self.landing_left == 0 {
+            self.held_ticks = 0;
+        }
+        if falling {
+            let within_bound = self.held_ticks < rate.ticks_from_ms(config.max_hold_ms);
+            self.landing_left = if within_bound {
+                rate.ticks_from_ms(config.landing_ms).max(1)
+            } else {
+                0
+            };
+        }
+        if self.landing_left == 0 {
+            self.since_hold = self.since_hold.saturating_add(1);
+            return None;
+        }
+        self.since_hold = 0;
+        if !falling {
+            self.landing_left = self.landing_left.saturating_sub(1);
+        }
+        self.held_ticks = self.held_ticks.saturating_add(1);
+        Some(config.hold_nm_per_rad_s * (hold_rate_rad_s - rate_rad_s))
+    }
+
+    /// Whether the wheels hold for a fall now.
+    pub fn holding(&self) -> bool {
+        self.landing_left > 0
+    }
+
+    /// Whether the wheels held for a fall within the last `ticks`: a stall then is the landing
+    /// or the edge just rolled off, not a riser to climb.
+    pub fn fell_within(&self, ticks: u32) -> bool {
+        self.since_hold <= ticks
+    }
+}
+
+impl Default for Traction {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const RATE: TickRate = TickRate::SIM_250_HZ;
+
+    fn tick(traction: &mut Traction, force_m_s2: f32) -> Option<f32> {
+        let config = TractionConfig::ROBOT;
+        traction.record(&config, force_m_s2);
+        traction.update(&config, RATE, -8.0, -4.0)
+    }
+
+    #[test]
+    fn carried_the_law_drives_falling_the_wheels_turn_at_the_reference_until_landed() {
+        let mut traction = Traction::new();
+        assert_eq!(tick(&mut traction, 9.8), None);
+        assert_eq!(tick(&mut traction, 1.0), None, "one light sample is noise");
+        let hold = tick(&mut traction, 1.0);
+        assert!(
+            hold.is_some_and(|nm| nm > 0.0),
+            "slows the spun-up wheels: {hold:?}"
+        );
+        for _ in 0..20_u32 {
+            assert!(tick(&mut traction, 0.5).is_some());
+        }
+        // Landed: held for the landing, then the law again.
+        let landing = RATE.ticks_from_ms(TractionConfig::ROBOT.landing_ms);
+        for _ in 0..landing {
+            assert!(tick(&mut traction, 30.0).is_some());
+        }
+        assert_eq!(tick(&mut traction, 9.8), None);
+        assert!(!traction.holding());
+    }
+
+    #[test]
+    fn a_fall_longer_than_a_drop_gives_the_wheels_back_to_the_law() {
+        let mut traction = Traction::new();
+        let bound = RATE.ticks_from_ms(TractionConfig::ROBOT.max_hold_ms);
+        let held = (0..2 * bound)
+            .filter(|_| tick(&mut traction, 0.0).is_some())
+            .count();
+        let landing = RATE.ticks_from_ms(TractionConfig::ROBOT.landing_ms);
+        assert!(held as u32 <= bound + landing, "held {held} ticks");
+        assert_eq!(tick(&mut traction, 0.0), None);
+    }
+}
