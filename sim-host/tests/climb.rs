@@ -12,7 +12,7 @@
 
 mod common;
 
-use common::climb::{run, run_standing_first, StepBehind, Trial, ON_WHEELS_M};
+use common::climb::{run, run_standing_first, StepBehind, Trial, LONG_PLATEAU_M, ON_WHEELS_M};
 use firmware::control::fsm::{State, WheelMotion};
 use protocol::TeleopMode;
 use sim_host::campaign::draw::Draw;
@@ -108,14 +108,14 @@ fn trials(height_m: f64, trials: u64, max_tilt_deg: f64, standing_first: bool) -
     (crossings, fell, touched)
 }
 
-/// The 6 cm case over 50 robots: none falls, and at least 45 cross up and down (pitch
-/// within 25°; measured 46, see docs/obstacles.md: short of the 95 %).
+/// The 6 cm case: at least 95 % of 50 robots cross up and down (pitch within 25°), and
+/// none falls.
 #[test]
 fn in_the_autonomous_mode_the_robot_crosses_a_6cm_step_up_and_down_and_drives_on() {
     const TRIALS: u64 = 50;
     let (crossings, fell, _) = trials(0.06, TRIALS, 25.0, false);
     assert_eq!(fell, 0);
-    assert!(crossings >= 45, "{crossings} of {TRIALS}");
+    assert!(crossings * 100 >= 95 * TRIALS, "{crossings} of {TRIALS}");
 }
 
 /// `S` is the operator's drive, not the autonomous mode: into the same step it stops with a
@@ -126,7 +126,7 @@ fn a_manual_drive_into_the_step_stops_with_a_stall_fault_and_does_not_climb() {
         let step = StepBehind {
             height_m: 0.06,
             distance_m: 1.2,
-            plateau_m: 6.0,
+            plateau_m: LONG_PLATEAU_M,
         };
         let f = run(seed, step, TeleopMode::WheelBackward, (None, None), 12.0);
         println!("MEASURED S, seed {seed}: {f:?}");

@@ -10,8 +10,10 @@
 //! reference asks for, and the robot lands rolling as fast as it moves; the balance law takes
 //! over again a moment after the weight is back.
 //!
-//! A fall is bounded: a hold longer than a step's drop takes ([`TractionConfig::max_hold_ms`])
-//! gives the wheels back to the law, so a sensor reading low cannot switch the balance off.
+//! A hold is bounded: one longer than a step's drop takes ([`TractionConfig::max_hold_ms`],
+//! and the landing's) gives the wheels back to the law, and a new one starts only after the law
+//! has had them for [`TractionConfig::rearm_ms`], so an accelerometer reading low cannot
+//! switch the balance off for more than a share of the time.
 
 use crate::time::TickRate;
 
@@ -25,8 +27,10 @@ pub struct TractionConfig {
     /// The wheels hold until the specific force has been back over
     /// [`TractionConfig::falling_m_s2`] for this long, ms (the landing).
     pub landing_ms: u32,
-    /// … and for no longer than this in all, ms (a 10 cm drop takes 140 ms).
+    /// … and no longer than this and the landing, ms (a 10 cm drop takes 140 ms).
     pub max_hold_ms: u32,
+    /// A new hold starts only this long after the last one ended, ms.
+    pub rearm_ms: u32,
     /// The hold's torque per rad/s off the rate asked for, N·m·s/rad (both wheels together).
     pub hold_nm_per_rad_s: f32,
 }
@@ -38,6 +42,7 @@ impl TractionConfig {
         falling_samples: 2,
         landing_ms: 40,
         max_hold_ms: 300,
+        rearm_ms: 700,
         hold_nm_per_rad_s: 1.0,
     };
 }
@@ -94,7 +99,8 @@ impl Traction {
         if !falling && self.landing_left == 0 {
             self.held_ticks = 0;
         }
-        if falling {
+        let rearmed = self.since_hold >= rate.ticks_from_ms(config.rearm_ms);
+        if falling && (self.landing_left > 0 || rearmed) {
             let within_bound = self.held_ticks < rate.ticks_from_ms(config.max_hold_ms);
             self.landing_left = if within_bound {
                 rate.ticks_from_ms(config.landing_ms).max(1)
@@ -172,9 +178,42 @@ mod tests {
         let bound = RATE.ticks_from_ms(TractionConfig::ROBOT.max_hold_ms);
         let held = (0..2 * bound)
             .filter(|_| tick(&mut traction, 0.0).is_some())
-            .count();
-        let landing = RATE.ticks_from_ms(TractionConfig::ROBOT.landing_ms);
-        assert!(held as u32 <= bound + landing, "held {held} ticks");
+            .count() as u32;
+        assert_eq!(held, bound, "held for the bound, then the law");
         assert_eq!(tick(&mut traction, 0.0), None);
+    }
+
+    #[test]
+    fn a_sensor_reading_low_most_of_the_time_leaves_the_law_most_of_it() {
+        let mut traction = Traction::new();
+        let ticks = 10 * RATE.ticks_from_ms(1_000);
+        // Light, with one normal sample in ten.
+        let held = (0..ticks)
+            .filter(|i| tick(&mut traction, if i % 10 == 0 { 9.8 } else { 0.0 }).is_some())
+            .count() as u32;
+        let config = TractionConfig::ROBOT;
+        let cycle = config.max_hold_ms + config.landing_ms + config.rearm_ms;
+        let most = (config.max_hold_ms + config.landing_ms) as f32 / cycle as f32;
+        assert!(
+            held as f32 <= most * ticks as f32 + 1.0,
+            "held {held} of {ticks}"
+        );
+        assert!(held > 0);
+    }
+
+    #[test]
+    fn a_stall_soon_after_a_fall_is_known_as_one() {
+        let mut traction = Traction::new();
+        assert!(!traction.fell_within(1_000));
+        for _ in 0..5_u32 {
+            tick(&mut traction, 0.0);
+        }
+        let landing = RATE.ticks_from_ms(TractionConfig::ROBOT.landing_ms);
+        for _ in 0..landing + 10 {
+            tick(&mut traction, 9.8);
+        }
+        assert!(!traction.holding());
+        assert!(traction.fell_within(20));
+        assert!(!traction.fell_within(5));
     }
 }

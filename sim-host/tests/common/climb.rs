@@ -90,25 +90,28 @@ pub fn run(
         PlanStep::at(MODE_AT_S, mode),
     ];
     plan.extend(stop_s.map(|at_s| PlanStep::at(at_s, TeleopMode::Stop)));
-    run_plan(seed, step, plan, latch_s, end_s)
+    run_plan(seed, step, plan, (MODE_AT_S, latch_s), end_s)
 }
 
 /// As [`run`] in the autonomous mode without stops, but the robot first stands still for
 /// 1.5 s and is folded from there, the mode sent 4 s later.
 pub fn run_standing_first(seed: u64, step: StepBehind, end_s: f64) -> Trial {
+    let mode_at_s = 1.5 + MODE_AT_S;
     let plan = vec![
         PlanStep::at(0.0, TeleopMode::Stand),
         PlanStep::at(1.5, TeleopMode::Fold),
-        PlanStep::at(1.5 + MODE_AT_S, TeleopMode::Auto),
+        PlanStep::at(mode_at_s, TeleopMode::Auto),
     ];
-    run_plan(seed, step, plan, None, end_s)
+    run_plan(seed, step, plan, (mode_at_s, None), end_s)
 }
 
+/// Runs `plan` (its mode sent at `mode_at_s`, from when tilt and roll count), an E-stop
+/// latched at `latch_s` if any.
 fn run_plan(
     seed: u64,
     step: StepBehind,
     plan: Vec<PlanStep>,
-    latch_s: Option<f64>,
+    (mode_at_s, latch_s): (f64, Option<f64>),
     end_s: f64,
 ) -> Trial {
     let riser_x_m = -step.distance_m;
@@ -148,7 +151,7 @@ fn run_plan(
             }
         }
         let physics = rig.sim().physics();
-        if rig.time_s() > MODE_AT_S {
+        if rig.time_s() > mode_at_s {
             max_tilt_deg = max_tilt_deg.max(record.tilt_deg);
             let [roll_rad, _, _] = physics.torso().rpy_rad();
             max_roll_deg = max_roll_deg.max(roll_rad.to_degrees().abs());

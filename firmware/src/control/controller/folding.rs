@@ -250,13 +250,13 @@ impl Controller {
         self.within_limits(self.levelling.pose(&self.config.levelling))
     }
 
-    /// Where a fold tucks the legs: the fold pose; after a climb with the front legs clear
+    /// Where a fold tucks the legs: the fold pose; after a climb (or on top) with the front legs clear
     /// ([`Controller::with_front_clear`]): tucked under the torso, they dragged on the plateau
     /// as the balance law caught the robot tipping off its back feet, and the robot ran away.
     #[inline(never)] // As `level`.
     fn fold_goal_rad(&self) -> Joints<f32> {
         let fold_rad = self.fold_rad();
-        if self.climbed {
+        if self.climbed || self.on_top {
             self.with_front_clear(fold_rad)
         } else {
             fold_rad

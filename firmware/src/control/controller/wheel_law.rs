@@ -64,7 +64,9 @@ impl Controller {
                 &self.config.traction,
                 self.config.rate,
                 self.sensors.mean_wheel_rate_rad_s(),
-                input.velocity_ref_m_s / self.config.balance.wheel_radius_m,
+                // The wheels' rate against the torso that rolls them at the reference: the
+                // ground speed is r (ω + θ̇).
+                input.velocity_ref_m_s / self.config.balance.wheel_radius_m - pitch_rate_rad_s,
             );
             if let (true, Some(hold_nm)) = (auto, hold) {
                 common = hold_nm;
