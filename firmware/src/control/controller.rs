@@ -440,16 +440,7 @@ impl Controller {
             self.fold_done_at = None;
             self.climbed = false;
         }
-        // On the plateau the front legs stay clear whatever the wheels are asked next (a STOP
-        // there does not swing them); off the wheels the climb is over.
-        self.on_top &= matches!(
-            next,
-            State::Wheels(_) | State::Folding(_) | State::Climbing(_)
-        );
-        if next == State::Wheels(WheelMotion::Auto) && self.state != next {
-            // A bounce in a manual mode is no drop the autonomous mode rolled off.
-            self.traction.reset();
-        }
+        self.climb_flags_into(next);
         let moving_on_wheels = matches!(self.state, State::Wheels(motion) if motion.moving());
         self.stopped_on_wheels = moving_on_wheels && next == State::Wheels(WheelMotion::Balance);
         self.state = next;
