@@ -314,11 +314,7 @@ impl Controller {
             State::Folding(_) => self.fold_step(now, depth_m),
             State::Climbing(_) => self.climb_step(now),
             State::Wheels(_) => {
-                self.goal_rad = if self.on_top {
-                    self.with_front_clear(self.fold_rad())
-                } else {
-                    self.fold_rad()
-                };
+                self.goal_rad = self.fold_goal_rad();
                 self.smooth(self.config.fold_rate_per_s);
             }
         }
@@ -427,6 +423,10 @@ impl Controller {
         }
         if !matches!(next, State::Wheels(_)) {
             self.runaway.reset();
+        }
+        // A bounce in a manual mode is no drop the autonomous mode rolled off.
+        let entering_auto = next == State::Wheels(WheelMotion::Auto) && self.state != next;
+        if !matches!(next, State::Wheels(_)) || entering_auto {
             self.traction.reset();
         }
         // A new request while folding (W after F) changes what follows the fold, not the fold.

@@ -33,16 +33,12 @@ impl Controller {
 
     /// What a transition into `next` keeps of a climb: on the plateau the front legs stay
     /// clear whatever the wheels are asked next (a STOP there does not swing them); off the
-    /// wheels the climb is over. A bounce in a manual mode is no drop the autonomous mode
-    /// rolled off.
+    /// wheels the climb is over.
     pub(super) fn climb_flags_into(&mut self, next: State) {
         self.on_top &= matches!(
             next,
             State::Wheels(_) | State::Folding(_) | State::Climbing(_)
         );
-        if next == State::Wheels(WheelMotion::Auto) && self.state != next {
-            self.traction.reset();
-        }
     }
 
     /// The climb under way, if any.

@@ -250,11 +250,12 @@ impl Controller {
         self.within_limits(self.levelling.pose(&self.config.levelling))
     }
 
-    /// Where a fold tucks the legs: the fold pose; after a climb (or on top) with the front legs clear
-    /// ([`Controller::with_front_clear`]): tucked under the torso, they dragged on the plateau
-    /// as the balance law caught the robot tipping off its back feet, and the robot ran away.
+    /// Where a fold tucks the legs, and where they ride on the wheels: the fold pose; after a
+    /// climb (or on top) with the front legs clear ([`Controller::with_front_clear`]): tucked
+    /// under the torso, they dragged on the plateau as the balance law caught the robot
+    /// tipping off its back feet, and the robot ran away.
     #[inline(never)] // As `level`.
-    fn fold_goal_rad(&self) -> Joints<f32> {
+    pub(super) fn fold_goal_rad(&self) -> Joints<f32> {
         let fold_rad = self.fold_rad();
         if self.climbed || self.on_top {
             self.with_front_clear(fold_rad)
@@ -266,7 +267,7 @@ impl Controller {
     /// `pose` with the front legs as the autonomous mode carries them: high, clear of a
     /// plateau's edge the wheels roll off ([`crate::legs::levelling::FoldFamily::front_clear`]).
     #[inline(never)] // As `level`.
-    pub(super) fn with_front_clear(&self, pose: Joints<f32>) -> Joints<f32> {
+    fn with_front_clear(&self, pose: Joints<f32>) -> Joints<f32> {
         let left = self.config.levelling.family.front_clear;
         let right = LegJoints {
             hip_abduction_rad: -left.hip_abduction_rad,
