@@ -279,7 +279,7 @@ fn initramfs(
     std::fs::copy(which("busybox")?, dir.join("bin/busybox")).map_err(|e| e.to_string())?;
     for applet in [
         "sh", "mount", "insmod", "poweroff", "echo", "cat", "ls", "sleep", "mkdir", "kill", "rm",
-        "env", "uname", "head", "tail", "grep", "date", "true",
+        "env", "uname", "head", "tail", "grep", "date", "true", "renice",
     ] {
         std::os::unix::fs::symlink("busybox", dir.join("bin").join(applet))
             .map_err(|e| e.to_string())?;
