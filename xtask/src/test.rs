@@ -8,8 +8,35 @@ use crate::util::{cargo, root, run as sh};
 /// Crates that must stay `no_std` and free of `f64`.
 const NO_STD_CRATES: [&str; 2] = ["protocol", "firmware"];
 
+/// Prints how long each step took, so that a slow CI run says where its time went.
+struct Steps {
+    started: std::time::Instant,
+    step: std::time::Instant,
+}
+
+impl Steps {
+    fn new() -> Self {
+        let now = std::time::Instant::now();
+        Self {
+            started: now,
+            step: now,
+        }
+    }
+
+    fn done(&mut self, what: &str) {
+        eprintln!(
+            "test: {what} took {:.0} s ({:.1} min in all)",
+            self.step.elapsed().as_secs_f64(),
+            self.started.elapsed().as_secs_f64() / 60.0
+        );
+        self.step = std::time::Instant::now();
+    }
+}
+
 pub fn run() -> Result<(), String> {
+    let mut steps = Steps::new();
     crate::setup::run()?;
+    steps.done("setup");
     sh(cargo().args(["fmt", "--all", "--check"]))
         .map_err(|e| format!("{e}\nformatting differs: run `cargo fmt --all`"))?;
     sh(cargo().args([
@@ -24,11 +51,13 @@ pub fn run() -> Result<(), String> {
     crate::dbc::run(&["--check".to_string()])?;
     check_no_f64()?;
     check_file_lengths()?;
+    steps.done("fmt, clippy, dbc and source checks");
     // The vcan suite needs a kernel with vcan and root; `cargo xtask hil` provides both (here
     // or in a VM), below.
     sh(cargo()
         .args(["test", "--workspace", "--exclude", "hil-tests"])
         .env("PROTOCOL_PYTHON", venv_python()))?;
+    steps.done("workspace tests");
     // Headless rendering through Mesa EGL (the feature is off by default).
     sh(cargo().args([
         "test",
@@ -39,6 +68,7 @@ pub fn run() -> Result<(), String> {
         "--test",
         "render",
     ]))?;
+    steps.done("render test");
     let mut build = cargo();
     build.args(["build", "--target", MCU_TARGET]);
     for krate in NO_STD_CRATES {
@@ -53,6 +83,7 @@ pub fn run() -> Result<(), String> {
         doc.args(["-p", krate]);
     }
     sh(&mut doc)?;
+    steps.done("MCU build and docs");
     // The MCU images: clippy for their target (on the host they are stubs), the STM32 image
     // built and sized, and processor-in-the-loop in QEMU against the host build.
     let mut clippy = cargo();
@@ -73,11 +104,14 @@ pub fn run() -> Result<(), String> {
     sh(&mut clippy)?;
     crate::firmware::run()?;
     crate::pil::run(&[])?;
+    steps.done("MCU clippy, image and PIL");
     // libFuzzer from the committed seeds: a minute per frame target, 20 s per other target
     // (the long runs are documented).
     crate::fuzz::ci()?;
+    steps.done("fuzzing");
     // Ten simulated minutes of the soak (the day is `cargo xtask soak`).
     crate::soak::run(&["--minutes".to_string(), "10".to_string()])?;
+    steps.done("soak");
     // A hundred trials of the robustness campaign; the table in docs/campaign.md must be the
     // one they give (the 500-trial run is `cargo xtask campaign`).
     crate::campaign::run(&[
@@ -85,7 +119,9 @@ pub fn run() -> Result<(), String> {
         "100".to_string(),
         "--check".to_string(),
     ])?;
+    steps.done("campaign");
     crate::hil::run(&[])?;
+    steps.done("vcan suite");
     eprintln!("test: all checks passed");
     Ok(())
 }
