@@ -16,6 +16,7 @@ use crate::legs::transfer::TransferConfig;
 use crate::limits::JointLimits;
 use crate::time::TickRate;
 use crate::wheels::balance::{BalanceConfig, BalanceGains, BalanceModel};
+use crate::wheels::lean::LeanConfig;
 use crate::wheels::runaway::RunawayConfig;
 use crate::wheels::traction::TractionConfig;
 use crate::wheels::wheel::SpeedLoopGains;
@@ -95,6 +96,8 @@ pub struct Config {
     pub runaway: RunawayConfig,
     /// When the wheels count as off the ground, and how they hold meanwhile.
     pub traction: TractionConfig,
+    /// When a lean says the robot rests on something other than its wheels.
+    pub lean: LeanConfig,
     /// When the trot counts as blocked by what it cannot step over.
     pub blocked: BlockedConfig,
     /// How the autonomous mode climbs a step its wheels stall against
@@ -150,6 +153,7 @@ impl Config {
         stop: StopConfig::ROBOT,
         runaway: RunawayConfig::ROBOT,
         traction: TractionConfig::ROBOT,
+        lean: LeanConfig::ROBOT,
         blocked: BlockedConfig::ROBOT,
         climb: Some(ClimbConfig::ROBOT),
     };

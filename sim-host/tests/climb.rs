@@ -14,7 +14,7 @@ mod common;
 
 use common::climb::{run, run_standing_first, StepBehind, Trial, LONG_PLATEAU_M, ON_WHEELS_M};
 use firmware::control::fsm::{State, WheelMotion};
-use protocol::TeleopMode;
+use protocol::{FaultFlags, TeleopMode};
 use sim_host::campaign::draw::Draw;
 use sim_host::scene::Step;
 
@@ -118,6 +118,63 @@ fn in_the_autonomous_mode_the_robot_crosses_a_6cm_step_up_and_down_and_drives_on
     assert!(crossings * 100 >= 95 * TRIALS, "{crossings} of {TRIALS}");
 }
 
+/// How far a robot that did not get onto the plateau may end from where it met the riser, m:
+/// what a fold from its lean against the riser rolls it, and a runaway on its back shanks
+/// until the lean watch stops it ([`firmware::wheels::lean`]; 1.1–1.3 m, measured).
+const REFUSED_TRAVEL_M: f64 = 1.5;
+
+/// The issue's 10 cm case (±1 cm): higher than the climb takes. Every one of 50 robots stops
+/// safely and says why: it refuses the step (`STEP_REFUSED`) or stops with a fault flag, one
+/// that stays before the riser ends within [`REFUSED_TRAVEL_M`] of it, and none falls or
+/// drives on.
+#[test]
+fn in_the_autonomous_mode_a_10cm_step_is_a_safe_stop_with_a_reason() {
+    let reasons = FaultFlags::STEP_REFUSED
+        .with(FaultFlags::RUNAWAY)
+        .with(FaultFlags::WHEEL_STALL);
+    let (mut refused, mut worst_m) = (0, 0.0_f64);
+    for seed in 0..50 {
+        let (step, f) = up_and_down(seed, 0.10, false);
+        let moved_m = f.climb_start_x_m.map(|x| (f.torso_x_m - x).abs());
+        let on_plateau = f.onto_plateau_m > 0.0;
+        println!(
+            "MEASURED 10 cm: {:.3} m step, seed {seed}: fell {:?}, faults {:?}, moved {moved_m:?} m after meeting it, states {:?}",
+            step.height_m, f.fell_at, f.faults, f.states
+        );
+        assert!(f.fell_at.is_none(), "seed {seed} fell: {f:?}");
+        assert!(!crossed(&f, &step, 30.0), "seed {seed} crossed: {f:?}");
+        assert!(
+            f.climb_start_x_m.is_some(),
+            "seed {seed} never met the riser: {f:?}"
+        );
+        assert!(
+            f.faults.bits() & reasons.bits() != 0,
+            "seed {seed} stopped without a reason: {f:?}"
+        );
+        assert!(
+            on_plateau || moved_m.is_some_and(|m| m < REFUSED_TRAVEL_M),
+            "seed {seed} ran away: {f:?}"
+        );
+        assert!(
+            matches!(
+                f.last(),
+                Some(State::Wheels(WheelMotion::Balance) | State::Fault)
+            ),
+            "seed {seed}: {f:?}"
+        );
+        refused += u32::from(f.faults.contains(FaultFlags::STEP_REFUSED));
+        worst_m = worst_m.max(if on_plateau {
+            0.0
+        } else {
+            moved_m.unwrap_or(0.0)
+        });
+    }
+    println!(
+        "MEASURED 10 cm: {refused} of 50 refused the step, the others stopped with a fault; \
+         the farthest one before the riser ended {worst_m:.2} m from it"
+    );
+}
+
 /// `S` is the operator's drive, not the autonomous mode: into the same step it stops with a
 /// stall fault where it met it, and does not climb.
 #[test]
@@ -140,9 +197,8 @@ fn a_manual_drive_into_the_step_stops_with_a_stall_fault_and_does_not_climb() {
 /// Higher steps, and the 6 cm step after a fold from standing still, measured (`cargo test
 /// --release -p sim-host --test climb -- --ignored --nocapture`).
 #[test]
-#[ignore = "measurement: the 8 and 10 cm and standing-first figures in docs/obstacles.md"]
+#[ignore = "measurement: the 8 cm and standing-first figures in docs/obstacles.md"]
 fn higher_steps_and_a_fold_from_standing_measured() {
     trials(0.08, 50, 30.0, false);
-    trials(0.10, 50, 30.0, false);
     trials(0.06, 50, 25.0, true);
 }

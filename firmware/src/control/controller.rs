@@ -42,6 +42,7 @@ use crate::legs::support::LegStance;
 use crate::legs::transfer::Transfer;
 use crate::time::Tick;
 use crate::wheels::balance::Balance;
+use crate::wheels::lean::LeanWatch;
 use crate::wheels::runaway::Runaway;
 use crate::wheels::traction::Traction;
 use crate::wheels::wheel::SpeedLoop;
@@ -89,6 +90,8 @@ pub struct Controller {
     runaway: Runaway,
     /// Whether the wheels are on the ground ([`crate::wheels::traction`]).
     traction: Traction,
+    /// Whether the robot leans on something other than its wheels ([`crate::wheels::lean`]).
+    lean: LeanWatch,
     /// What the runaway detector found, reported until the fault is reset.
     wheel_fault: FaultFlags,
     /// An authentic release heard while the controlled stop still ran: it takes effect when
@@ -174,6 +177,7 @@ impl Controller {
             stop: None,
             runaway: Runaway::new(&config.runaway, rate),
             traction: Traction::new(),
+            lean: LeanWatch::new(&config.lean, rate),
             wheel_fault: FaultFlags::EMPTY,
             release_pending: false,
             transfer: None,
@@ -354,6 +358,7 @@ impl Controller {
         if !(self.balancing() && self.armed && self.wheels_may_drive()) {
             self.wheels_since = None;
             self.balance.reset();
+            self.lean.reset();
             self.turn.reset();
             self.turn_ref_rad_s = 0.0;
             return [0.0; 2];
@@ -364,8 +369,9 @@ impl Controller {
             self.fold_return = Some((now, self.carried_forward_m()));
         }
         let mut wheel_torque_nm = self.wheel_law(now, dt_s);
-        if matches!(self.state, State::Climbing(_)) {
-            // The wheels stalled this tick and a climb began: they hold from now.
+        if matches!(self.state, State::Climbing(_)) || self.leans_on_its_legs(now) {
+            // The wheels stalled this tick and a climb began, or the robot leans on its legs:
+            // they hold from now.
             return self.hold_wheels(dt_s);
         }
         if matches!(self.state, State::Folding(_)) {

@@ -6,7 +6,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use firmware::control::fsm::State;
 use host_can::fault_plan::Faults;
-use protocol::{AnyMessage, EStop, NodeId, Session, TeleopMode, TEST_KEY};
+use protocol::{AnyMessage, EStop, FaultFlags, NodeId, Session, TeleopMode, TEST_KEY};
 use sim_host::campaign::draw::Draws;
 use sim_host::campaign::Drives;
 use sim_host::faults::rig::Rig;
@@ -58,6 +58,10 @@ pub struct Trial {
     pub contacts: Vec<(f64, String)>,
     /// Where the torso was along the path at the end, m (the start at 0, the step behind).
     pub torso_x_m: f64,
+    /// … and when the first climb began, m.
+    pub climb_start_x_m: Option<f64>,
+    /// Every fault the controller reported after the mode was sent.
+    pub faults: FaultFlags,
 }
 
 impl Trial {
@@ -130,6 +134,7 @@ fn run_plan(
     let (mut fell_at, mut states, mut max_tilt_deg) = (None, Vec::new(), 0.0_f64);
     let mut max_roll_deg = 0.0_f64;
     let mut contacts: Vec<(f64, String)> = Vec::new();
+    let (mut faults, mut climb_start_x_m) = (FaultFlags::EMPTY, None);
     let mut latch_s = latch_s;
     while rig.time_s() < end_s {
         if latch_s.is_some_and(|at_s| rig.time_s() >= at_s) {
@@ -146,12 +151,16 @@ fn run_plan(
             fell_at = Some((rig.time_s(), record.state));
         }
         if let Some(state) = record.state {
+            if climb_start_x_m.is_none() && matches!(state, State::Climbing(_)) {
+                climb_start_x_m = Some(record.torso_pos_m[0]);
+            }
             if states.last().is_none_or(|&(_, last)| last != state) {
                 states.push((rig.time_s(), state));
             }
         }
         let physics = rig.sim().physics();
         if rig.time_s() > mode_at_s {
+            faults = faults.with(record.faults);
             max_tilt_deg = max_tilt_deg.max(record.tilt_deg);
             let [roll_rad, _, _] = physics.torso().rpy_rad();
             max_roll_deg = max_roll_deg.max(roll_rad.to_degrees().abs());
@@ -173,5 +182,7 @@ fn run_plan(
         max_roll_deg,
         contacts,
         torso_x_m: torso.pos_m[0],
+        climb_start_x_m,
+        faults,
     }
 }

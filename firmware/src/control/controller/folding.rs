@@ -157,6 +157,7 @@ impl Controller {
         }
         self.wheels_since = None;
         self.balance.reset();
+        self.lean.reset();
         [-gain * left, -gain * right]
     }
 

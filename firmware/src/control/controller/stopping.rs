@@ -1,11 +1,12 @@
 //! The controlled stop: the E-stop's latch, and the stall or runaway that stops the robot
 //! into `Fault` the same way (see [`crate::control::stop`]).
 
-use protocol::FaultFlags;
+use protocol::{FaultFlags, Leg};
 
 use super::Controller;
 use crate::control::fsm::{Event, State};
 use crate::control::stop::{Carrier, Stop, StopCommand, StopInput};
+use crate::legs::crawl::foot_loads_n;
 use crate::time::Tick;
 
 impl Controller {
@@ -103,6 +104,39 @@ impl Controller {
             Carrier::Wheels
         };
         self.start_stop(now, carrier);
+    }
+
+    /// The lean watch on this tick of the balance law: a robot that leans on its legs
+    /// ([`crate::wheels::lean`]) goes to `Fault` ([`FaultFlags::RUNAWAY`])
+    /// with the controlled stop of a robot against an obstacle, its wheels held still; `true`
+    /// if it did.
+    #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
+    pub(super) fn leans_on_its_legs(&mut self, now: Tick) -> bool {
+        let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
+        let sensors = &self.sensors;
+        let geometry = &self.config.geometry;
+        let legs_load_n = || {
+            let loads = foot_loads_n(
+                geometry,
+                &sensors.joint_position_rad,
+                &sensors.joint_effort_nm,
+            );
+            Leg::ALL
+                .iter()
+                .map(|&leg| loads.get(leg).unwrap_or(0.0))
+                .sum::<f32>()
+        };
+        if !self.lean.update(&self.config.lean, lean_rad, legs_load_n) {
+            return false;
+        }
+        self.apply(Event::Fault);
+        if self.state != State::Fault {
+            return false;
+        }
+        self.wheel_fault = FaultFlags::RUNAWAY;
+        self.balance.rebase(self.ground_speed_m_s());
+        self.start_stop(now, Carrier::Blocked);
+        true
     }
 
     /// This tick of the controlled stop (torque-free if none runs).

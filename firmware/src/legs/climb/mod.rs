@@ -85,6 +85,12 @@ pub struct ClimbConfig {
     pub lift_m: f32,
     /// How long the lift, a retreat from it and the last lowering onto the wheels take, ms.
     pub rise_ms: u32,
+    /// How far through the rise the step's height is first judged, 0…1: late enough that
+    /// the feet carry the robot and the estimate has settled, early enough that a step too
+    /// high has not yet pitched the body over its front feet (at 9–11 cm the last third of
+    /// the rise tipped robots 10–15° further and rolled them, and the retreat from there
+    /// put the torso down).
+    pub rise_check_share: f32,
     /// How much the back legs shorten at the end, m, …
     pub lower_back_m: f32,
     /// … and the front legs (they stand ahead of their hips there, near their reach), m: the
@@ -126,10 +132,11 @@ impl ClimbConfig {
         step_ms: 1200,
         lift_m: 0.03,
         rise_ms: 2000,
+        rise_check_share: 0.6,
         lower_back_m: 0.10,
         lower_front_m: 0.045,
         step_min_m: 0.03,
-        step_max_m: 0.09,
+        step_max_m: 0.085,
         pitch_max_rad: deg_to_rad(12.0),
         over_pitch_max_rad: deg_to_rad(15.0),
     };
@@ -220,6 +227,8 @@ pub struct Climb {
     before_rise: PerLeg<Foot>,
     /// How a retreat ends.
     retreat_end: ClimbEnd,
+    /// Whether the step's height was judged partway up the rise.
+    rise_checked: bool,
 }
 
 impl Climb {
@@ -234,6 +243,7 @@ impl Climb {
             down: PerLeg::splat(false),
             before_rise: feet,
             retreat_end: ClimbEnd::StepOutOfRange,
+            rise_checked: false,
         }
     }
 
@@ -351,11 +361,19 @@ impl Climb {
                 ..from
             };
         }
+        // The body's pitch and the two pairs' depths say how much higher the back feet stand
+        // than the front ones. A step higher than the crawl carries the robot over safely is
+        // stepped down from again, as early as the estimate is sound; a step too low only at
+        // the end, where the estimate is best.
+        let step_m = self.step_height_m(config, pitch_rad);
+        if !self.rise_checked && share >= config.rise_check_share {
+            self.rise_checked = true;
+            if step_m > config.step_max_m {
+                self.enter(Phase::Retreat, now);
+                return;
+            }
+        }
         if share >= 1.0 {
-            // Each pair now stands at its own depth; the body's pitch says how much higher the
-            // back feet stand than the front ones. A step the crawl does not carry the robot
-            // over safely is stepped down from again.
-            let step_m = self.step_height_m(config, pitch_rad);
             if (config.step_min_m..=config.step_max_m).contains(&step_m) {
                 self.enter(Phase::Shift { cycle: 0 }, now);
             } else {
