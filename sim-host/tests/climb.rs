@@ -5,8 +5,9 @@
 //! edge (the front legs carried high, the wheels held at the reference speed while they fall:
 //! `firmware::wheels::traction`) and drives on. Seeded trials over the campaign's robots as
 //! built (rated drives, real IMU and estimator, a cycle of delay), the step's height (±1 cm)
-//! and its distance behind the wheels when the mode starts (0.2–0.6 m). A manual drive (`S`)
-//! into the same step still stops with a stall fault.
+//! and its riser 1–2 m behind the start (the fold from standing wanders tens of cm). At 10 cm
+//! every robot stops safely and says why. A manual drive (`S`) into the same step still stops
+//! with a stall fault.
 //!
 //! `cargo test --release -p sim-host --test climb -- --nocapture` prints each robot's figures.
 
