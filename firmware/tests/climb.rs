@@ -86,12 +86,33 @@ fn a_step_that_reads_too_high_partway_up_the_rise_is_stepped_down_from_there() {
     let config = ClimbConfig::ROBOT;
     let (end, phases) = climb(pitched_in(Phase::Rise, deg_to_rad(20.0)));
     assert_eq!(end, Some(ClimbEnd::StepOutOfRange), "{phases:?}");
-    let began = |phase| phases.iter().find(|(p, _)| *p == phase).map(|(_, t)| *t);
-    let (Some(rise), Some(retreat)) = (began(Phase::Rise), began(Phase::Retreat)) else {
+    let began =
+        |phases: &[(Phase, u32)], phase| phases.iter().find(|(p, _)| *p == phase).map(|(_, t)| *t);
+    let (Some(rise), Some(retreat)) = (began(&phases, Phase::Rise), began(&phases, Phase::Retreat))
+    else {
         panic!("{phases:?}");
     };
     let checked = RATE.ticks_from_ms((config.rise_check_share * config.rise_ms as f32) as u32);
-    assert!(retreat - rise <= checked + 1, "{phases:?}");
+    assert!(
+        (checked.saturating_sub(1)..=checked + 1).contains(&(retreat - rise)),
+        "{phases:?}"
+    );
+    // Pitched nose up as far, the estimate reads lower: the rise goes on to its end.
+    let (_, phases) = climb(pitched_in(Phase::Rise, -deg_to_rad(20.0)));
+    let (Some(rise), Some(after)) = (
+        began(&phases, Phase::Rise),
+        phases
+            .iter()
+            .skip_while(|(p, _)| *p != Phase::Rise)
+            .nth(1)
+            .map(|(_, t)| *t),
+    ) else {
+        panic!("{phases:?}");
+    };
+    assert!(
+        after - rise >= RATE.ticks_from_ms(config.rise_ms),
+        "{phases:?}"
+    );
     // Level, the same climb lifts all the way and crawls over.
     let (end, _) = climb(pitched_in(Phase::Rise, 0.0));
     assert_eq!(end, Some(ClimbEnd::Over));

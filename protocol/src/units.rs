@@ -266,7 +266,8 @@ wire_flags!(
         /// cannot climb): the robot was braked and set down.
         WHEEL_STALL = 10 => "wheel_stall",
         /// The robot moved away from the speed reference, or the balance law stayed saturated
-        /// (a centre of mass off its trim, a push it cannot take): braked and set down.
+        /// (a centre of mass off its trim, a push it cannot take): braked and set down; or it
+        /// leaned on its legs while the balance law drove the wheels: the wheels held still.
         RUNAWAY = 11 => "runaway",
         /// The trot's leading feet ended their swings behind where they were sent, swing after
         /// swing (a step or a wall they cannot clear): the robot stopped and stands; cleared by

@@ -107,20 +107,28 @@ impl Controller {
     }
 
     /// The lean watch on this tick of the balance law: a robot that leans on its legs
-    /// ([`crate::wheels::lean`]) goes to `Fault` ([`FaultFlags::RUNAWAY`])
-    /// with the controlled stop of a robot against an obstacle, its wheels held still; `true`
-    /// if it did.
+    /// ([`crate::wheels::lean`]) goes to `Fault` ([`FaultFlags::RUNAWAY`]) with the controlled
+    /// stop of a robot against an obstacle, its wheels held still; `true` if it did. Not while
+    /// a controlled stop runs: that stop has the wheels, and the watch does not restart it.
     #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
     pub(super) fn leans_on_its_legs(&mut self, now: Tick) -> bool {
+        if self.stop.is_some() {
+            self.lean.reset();
+            return false;
+        }
         let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
         let sensors = &self.sensors;
         let geometry = &self.config.geometry;
         let legs_load_n = || {
-            let loads = foot_loads_n(
-                geometry,
-                &sensors.joint_position_rad,
-                &sensors.joint_effort_nm,
-            );
+            let efforts = &sensors.joint_effort_nm;
+            if !Leg::ALL
+                .iter()
+                .all(|&leg| efforts.leg(leg).iter().all(|nm| nm.is_finite()))
+            {
+                // Torques that cannot be read weigh as a load: the watch does not go blind.
+                return f32::NAN;
+            }
+            let loads = foot_loads_n(geometry, &sensors.joint_position_rad, efforts);
             Leg::ALL
                 .iter()
                 .map(|&leg| loads.get(leg).unwrap_or(0.0))
@@ -134,7 +142,7 @@ impl Controller {
             return false;
         }
         self.wheel_fault = FaultFlags::RUNAWAY;
-        self.balance.rebase(self.ground_speed_m_s());
+        // The stop holds the wheels from this tick: no speed to brake from.
         self.start_stop(now, Carrier::Blocked);
         true
     }
