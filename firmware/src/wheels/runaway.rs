@@ -5,7 +5,8 @@
 //! runs it away backward at 1.5 m/s; with its centre of mass a few centimetres off its trim the
 //! law saturates at rest and the robot runs away. Neither tilts the torso past the tilt fault.
 //! So the detector watches what the law can see: the ground speed against the speed reference,
-//! and the total wheel torque against its limit. Either out of bounds for long enough trips it.
+//! and the total wheel torque against its limit. Either out of bounds for long enough trips it,
+//! and so does a robot that stands still while it is asked to drive.
 //!
 //! The speed reference is rate-limited, so in normal driving the robot follows it closely; the
 //! thresholds ([`RunawayConfig::ROBOT`]) sit well above the largest error of the acceptance
@@ -51,6 +52,14 @@ pub struct RunawayConfig {
     /// m/s: a robot whose wheels slip in a limit cycle on low friction swings 0.5 m/s about its
     /// reference, decelerating as hard at every swing, and is running away, not blocked.
     pub struck_following_m_s: f32,
+    /// A robot asked for at least [`RunawayConfig::blocked_ref_m_s`] that moves slower than
+    /// this, m/s, …
+    pub blocked_m_s: f32,
+    /// … for this long is blocked, ms: one that backed softly into a riser (from 0.4 m away,
+    /// under the collision's deceleration) pushed against it until the run ended.
+    pub blocked_ms: u32,
+    /// The speed reference from which a robot standing still counts as blocked, m/s.
+    pub blocked_ref_m_s: f32,
 }
 
 impl RunawayConfig {
@@ -68,6 +77,9 @@ impl RunawayConfig {
         following_ms: 200,
         struck_ms: 600,
         struck_following_m_s: 0.3,
+        blocked_m_s: 0.05,
+        blocked_ms: 600,
+        blocked_ref_m_s: 0.2,
     };
 }
 
@@ -123,7 +135,10 @@ pub struct Runaway {
     /// reference, and whether it had been long enough when this deceleration began.
     near_ticks: u32,
     struck_armed: bool,
-    limits_ticks: [u32; 5],
+    limits_ticks: [u32; 6],
+    /// Ticks the robot has stood still against a speed reference (see
+    /// [`RunawayConfig::blocked_ms`]).
+    blocked_ticks: u32,
     /// Last tick's speed error, m/s (NaN: none yet), and the filtered rate it changes, m/s².
     last_error_m_s: f32,
     error_rate_m_s2: f32,
@@ -149,7 +164,9 @@ impl Runaway {
                 ticks(config.collision_ms),
                 ticks(config.following_ms),
                 ticks(config.struck_ms),
+                ticks(config.blocked_ms),
             ],
+            blocked_ticks: 0,
             last_error_m_s: f32::NAN,
             error_rate_m_s2: 0.0,
             period_s: rate.period_s(),
@@ -166,6 +183,7 @@ impl Runaway {
         self.struck_ticks = 0;
         self.near_ticks = 0;
         self.struck_armed = false;
+        self.blocked_ticks = 0;
         self.last_error_m_s = f32::NAN;
         self.error_rate_m_s2 = 0.0;
     }
@@ -190,7 +208,7 @@ impl Runaway {
             && self.error_rate_m_s2 * direction < 0.0
             && error * direction <= -config.collision_drop_m_s;
         let collision = against && beyond(self.error_rate_m_s2.abs(), config.collision_m_s2);
-        let [speed_limit, saturation_limit, collision_limit, following_limit, struck_limit] =
+        let [speed_limit, saturation_limit, collision_limit, following_limit, struck_limit, blocked_limit] =
             self.limits_ticks;
         self.struck_ticks = if collision && self.struck_armed {
             struck_limit
@@ -209,9 +227,13 @@ impl Runaway {
         self.speed_error_ticks = count(self.speed_error_ticks, speed_bad);
         self.saturated_ticks = count(self.saturated_ticks, saturated);
         self.collision_ticks = count(self.collision_ticks, collision && self.collision_armed);
+        let blocked = input.velocity_ref_m_s.abs() >= config.blocked_ref_m_s
+            && input.ground_speed_m_s.abs() < config.blocked_m_s;
+        self.blocked_ticks = count(self.blocked_ticks, blocked);
         let tripped = self.speed_error_ticks >= speed_limit
             || self.saturated_ticks >= saturation_limit
-            || self.collision_ticks >= collision_limit;
+            || self.collision_ticks >= collision_limit
+            || self.blocked_ticks >= blocked_limit;
         // The robot's speed does not decide it: thrown back from a step at 0.62 m/s, the
         // measured ground speed swung to 1.03 m/s and more (it adds the body's pitch rate,
         // which swings as the robot is thrown).
@@ -232,250 +254,4 @@ fn beyond(value: f32, bound: f32) -> bool {
 }
 
 #[cfg(test)]
-mod tests {
-    #![allow(clippy::expect_used, clippy::default_numeric_fallback)]
-
-    use super::*;
-
-    const CONFIG: RunawayConfig = RunawayConfig::ROBOT;
-
-    fn detector() -> Runaway {
-        // 250 Hz: 4 ms per tick.
-        Runaway::new(&CONFIG, TickRate::SIM_250_HZ)
-    }
-
-    fn input(speed: f32, reference: f32, torque: f32) -> RunawayInput {
-        RunawayInput {
-            ground_speed_m_s: speed,
-            velocity_ref_m_s: reference,
-            torque_nm: torque,
-            torque_limit_nm: 60.0,
-        }
-    }
-
-    fn ticks_to_trip(runaway: &mut Runaway, input: &RunawayInput) -> Option<(u32, FaultFlags)> {
-        (1..=1000).find_map(|tick| runaway.update(&CONFIG, input).map(|cause| (tick, cause)))
-    }
-
-    /// Ticks at 250 Hz of `ms`, as the detector counts them.
-    fn ticks(ms: u32) -> u32 {
-        TickRate::SIM_250_HZ.ticks_from_ms(ms)
-    }
-
-    #[test]
-    fn a_robot_stopped_hard_against_its_commanded_speed_trips_as_a_stall() {
-        let mut runaway = detector();
-        for _ in 0..50 {
-            assert_eq!(runaway.update(&CONFIG, &input(0.48, 0.48, 10.0)), None);
-        }
-        // Against a step: 0.48 m/s to rest in 0.1 s (4.8 m/s²), while the reference stays.
-        let mut speed = 0.48;
-        let found = (1..=100).find_map(|tick| {
-            speed = f32::max(speed - 4.8 * 0.004, 0.0);
-            let cause = runaway.update(&CONFIG, &input(speed, 0.48, 10.0));
-            cause.map(|cause| (tick, cause))
-        });
-        let (tick, cause) = found.expect("never tripped");
-        assert_eq!(cause, FaultFlags::WHEEL_STALL);
-        // The filter needs a few ticks to pass 2.5 m/s², then the collision time runs.
-        assert!((ticks(24)..=ticks(24) + 4).contains(&tick), "{tick}");
-    }
-
-    #[test]
-    fn a_robot_thrown_back_by_what_it_hit_trips_as_a_stall_not_a_runaway() {
-        let mut runaway = detector();
-        // Catching up with its reference, 0.18 m/s faster than it: not following, so the
-        // collision rule is not armed.
-        for _ in 0..100 {
-            assert_eq!(runaway.update(&CONFIG, &input(0.66, 0.48, 10.0)), None);
-        }
-        // Stopped by a step within 0.1 s and thrown back at 0.6 m/s: the speed error trips.
-        let mut speed = 0.66;
-        let found = (1..=200).find_map(|tick| {
-            speed = f32::max(speed - 6.0 * 0.004, -0.6);
-            let cause = runaway.update(&CONFIG, &input(speed, 0.48, -30.0));
-            cause.map(|cause| (tick, cause))
-        });
-        let (_, cause) = found.expect("never tripped");
-        assert_eq!(cause, FaultFlags::WHEEL_STALL);
-    }
-
-    #[test]
-    fn wheels_slipping_in_a_limit_cycle_trip_as_a_runaway_not_a_stall() {
-        let mut runaway = detector();
-        // On low friction the law and the slipping wheels swing the robot ±0.5 m/s about its
-        // 0.2 m/s reference at 4 Hz, decelerating at every swing as hard as in a collision…
-        for tick in 0..250_u32 {
-            let phase = tick as f32 * 0.004 * 4.0 * core::f32::consts::TAU;
-            let speed = 0.2 + 0.5 * phase.sin();
-            assert_eq!(runaway.update(&CONFIG, &input(speed, 0.2, 20.0)), None);
-        }
-        // … then runs away at 1.1 m/s.
-        let found = ticks_to_trip(&mut runaway, &input(1.1, 0.2, 20.0));
-        assert_eq!(found.map(|(_, cause)| cause), Some(FaultFlags::RUNAWAY));
-    }
-
-    #[test]
-    fn a_robot_far_from_its_reference_for_the_error_time_trips_as_a_runaway() {
-        for (speed, reference) in [(-0.5, 0.48), (0.8, 0.0), (-0.8, 0.0), (1.2, 0.48)] {
-            let mut runaway = detector();
-            let found = ticks_to_trip(&mut runaway, &input(speed, reference, 0.0));
-            let expected = Some((ticks(150), FaultFlags::RUNAWAY));
-            assert_eq!(found, expected, "{speed} {reference}");
-        }
-    }
-
-    #[test]
-    fn a_law_saturated_for_its_time_trips_even_at_the_reference_speed() {
-        let mut runaway = detector();
-        let found = ticks_to_trip(&mut runaway, &input(0.3, 0.3, -59.0));
-        assert_eq!(found, Some((ticks(300), FaultFlags::RUNAWAY)));
-    }
-
-    #[test]
-    fn lagging_braking_hard_stops_and_short_saturation_never_trip() {
-        let mut runaway = detector();
-        for round in 0..20 {
-            // A robot lagging its reference by 0.6 m/s, as in a stop from top speed.
-            for _ in 0..100 {
-                assert_eq!(runaway.update(&CONFIG, &input(0.6, 0.0, 20.0)), None);
-            }
-            // Stopping hard (8 m/s²) with the reference at zero: a stop's last centimetres.
-            let mut speed = 0.6;
-            for _ in 0..20 {
-                speed = f32::max(speed - 8.0 * 0.004, 0.0);
-                assert_eq!(runaway.update(&CONFIG, &input(speed, 0.0, 20.0)), None);
-            }
-            // Following the reference, then decelerating at 2 m/s² against it.
-            for _ in 0..50 {
-                assert_eq!(runaway.update(&CONFIG, &input(0.48, 0.48, 20.0)), None);
-            }
-            let mut speed = 0.48;
-            for _ in 0..50 {
-                speed -= 2.0 * 0.004;
-                assert_eq!(runaway.update(&CONFIG, &input(speed, 0.48, 20.0)), None);
-            }
-            // Saturated one tick short of the saturation time.
-            for _ in 1..ticks(300) {
-                assert_eq!(runaway.update(&CONFIG, &input(0.1, 0.1, 60.0)), None);
-            }
-            assert_eq!(
-                runaway.update(&CONFIG, &input(0.1, 0.1, 0.0)),
-                None,
-                "{round}"
-            );
-        }
-    }
-
-    #[test]
-    fn a_robot_stopped_hard_driving_backward_trips_as_a_stall() {
-        let mut runaway = detector();
-        for _ in 0..50 {
-            assert_eq!(runaway.update(&CONFIG, &input(-0.48, -0.48, -10.0)), None);
-        }
-        let mut speed = -0.48;
-        let found = (1..=100).find_map(|tick| {
-            speed = f32::min(speed + 4.8 * 0.004, 0.0);
-            let cause = runaway.update(&CONFIG, &input(speed, -0.48, -10.0));
-            cause.map(|cause| (tick, cause))
-        });
-        let (tick, cause) = found.expect("never tripped");
-        assert_eq!(cause, FaultFlags::WHEEL_STALL);
-        assert!((ticks(24)..=ticks(24) + 4).contains(&tick), "{tick}");
-    }
-
-    #[test]
-    fn a_sudden_stop_trips_as_a_stall_although_the_robot_no_longer_follows() {
-        // Whether the robot had followed its reference is judged before the deceleration:
-        // the collision itself takes it far from the reference at once.
-        let mut runaway = detector();
-        for _ in 0..ticks(CONFIG.following_ms) + 1 {
-            assert_eq!(runaway.update(&CONFIG, &input(0.48, 0.48, 10.0)), None);
-        }
-        let mut speed = 0.24;
-        let found = (1..=100).find_map(|tick| {
-            let cause = runaway.update(&CONFIG, &input(speed, 0.48, 10.0));
-            speed = f32::max(speed - 3.0 * 0.004, 0.0);
-            cause.map(|cause| (tick, cause))
-        });
-        let (tick, cause) = found.expect("never tripped");
-        assert_eq!(cause, FaultFlags::WHEEL_STALL);
-        assert!(tick <= ticks(24) + 4, "{tick}");
-    }
-
-    #[test]
-    fn an_error_at_its_bound_is_within_it() {
-        let mut runaway = detector();
-        let at_bound = input(CONFIG.speed_error_m_s, 0.0, 0.0);
-        assert_eq!(ticks_to_trip(&mut runaway, &at_bound), None);
-    }
-
-    #[test]
-    fn a_push_along_the_reference_is_no_collision() {
-        let mut runaway = detector();
-        for _ in 0..50 {
-            assert_eq!(runaway.update(&CONFIG, &input(0.48, 0.48, 10.0)), None);
-        }
-        // Shoved forward at 5 m/s² for 60 ms: as sharp as a collision, but along the
-        // reference.
-        let mut speed = 0.48;
-        for tick in 0..15 {
-            speed += 5.0 * 0.004;
-            let found = runaway.update(&CONFIG, &input(speed, 0.48, 10.0));
-            assert_eq!(found, None, "{tick}");
-        }
-    }
-
-    #[test]
-    fn a_robot_swinging_about_its_reference_is_no_collision() {
-        // A delayed loop's limit cycle: ±0.3 m/s at 3 Hz about 0.2 m/s, peaks of 5.7 m/s².
-        let mut runaway = detector();
-        for tick in 0..ticks(5_000) {
-            let phase = core::f32::consts::TAU * 3.0 * tick as f32 * 0.004;
-            let speed = 0.2 + 0.3 * phase.sin();
-            assert_eq!(
-                runaway.update(&CONFIG, &input(speed, 0.2, 20.0)),
-                None,
-                "{tick}"
-            );
-        }
-    }
-
-    #[test]
-    fn a_fast_limit_cycle_read_through_an_encoder_is_no_collision() {
-        // Driving at 0.48 m/s with two cycles of transport delay each way the loop swings at
-        // 10 Hz (±0.035 m/s measured in the closed loop, where it tripped the collision
-        // criterion after 3.5 s of driving), and the ground speed comes from 14-bit encoder
-        // counts, 0.0115 m/s a count at 250 Hz. A swing of ±0.08 m/s decelerates past 2.5 m/s²
-        // for longer than the collision time every cycle; its speed is then never 5 cm/s
-        // behind the reference (it is near the top of its swing).
-        let count_m_s = 0.12 * core::f32::consts::TAU / 16_384.0 / 0.004;
-        let mut runaway = detector();
-        for tick in 0..ticks(10_000) {
-            let phase = core::f32::consts::TAU * 10.0 * tick as f32 * 0.004;
-            let speed = 0.48 + 0.08 * phase.sin();
-            let read = (speed / count_m_s).round() * count_m_s;
-            assert_eq!(
-                runaway.update(&CONFIG, &input(read, 0.48, 10.0)),
-                None,
-                "{tick}"
-            );
-        }
-    }
-
-    #[test]
-    fn a_reset_starts_the_count_again_and_non_finite_input_counts_as_bad() {
-        let mut runaway = detector();
-        for _ in 1..ticks(150) {
-            assert_eq!(runaway.update(&CONFIG, &input(0.9, 0.0, 0.0)), None);
-        }
-        runaway.reset();
-        for _ in 1..ticks(150) {
-            assert_eq!(runaway.update(&CONFIG, &input(f32::NAN, 0.0, 0.0)), None);
-        }
-        assert_eq!(
-            runaway.update(&CONFIG, &input(f32::NAN, 0.0, 0.0)),
-            Some(FaultFlags::RUNAWAY)
-        );
-    }
-}
+mod tests;
