@@ -33,6 +33,9 @@ pub struct TractionConfig {
     pub rearm_ms: u32,
     /// The hold's torque per rad/s off the rate asked for, N·m·s/rad (both wheels together).
     pub hold_nm_per_rad_s: f32,
+    /// A hold that fell for at least this long was a drop off an edge, ms (a 6 cm drop takes
+    /// 110 ms); a shorter one was a bounce ([`Traction::fell_within`]).
+    pub drop_min_ms: u32,
 }
 
 impl TractionConfig {
@@ -44,6 +47,7 @@ impl TractionConfig {
         max_hold_ms: 300,
         rearm_ms: 700,
         hold_nm_per_rad_s: 1.0,
+        drop_min_ms: 60,
     };
 }
 
@@ -58,6 +62,10 @@ pub struct Traction {
     landing_left: u32,
     /// Ticks since the last hold ended (saturating; `u32::MAX` before the first).
     since_hold: u32,
+    /// Ticks the last hold fell (not counting its landing).
+    fell_ticks: u32,
+    /// Whether the last hold was a drop ([`TractionConfig::drop_min_ms`]).
+    dropped: bool,
 }
 
 impl Traction {
@@ -68,6 +76,8 @@ impl Traction {
             held_ticks: 0,
             landing_left: 0,
             since_hold: u32::MAX,
+            fell_ticks: 0,
+            dropped: false,
         }
     }
 
@@ -112,10 +122,17 @@ impl Traction {
             self.since_hold = self.since_hold.saturating_add(1);
             return None;
         }
+        if self.since_hold > 0 {
+            // A new hold.
+            self.fell_ticks = 0;
+        }
         self.since_hold = 0;
-        if !falling {
+        if falling {
+            self.fell_ticks = self.fell_ticks.saturating_add(1);
+        } else {
             self.landing_left = self.landing_left.saturating_sub(1);
         }
+        self.dropped = self.fell_ticks >= rate.ticks_from_ms(config.drop_min_ms);
         self.held_ticks = self.held_ticks.saturating_add(1);
         Some(config.hold_nm_per_rad_s * (hold_rate_rad_s - rate_rad_s))
     }
@@ -125,10 +142,12 @@ impl Traction {
         self.landing_left > 0
     }
 
-    /// Whether the wheels held for a fall within the last `ticks`: a stall then is the landing
-    /// or the edge just rolled off, not a riser to climb.
+    /// Whether the wheels held for a drop within the last `ticks`: a stall then is the landing
+    /// or the edge just rolled off, not a riser to climb. A bounce is no drop: set down on its
+    /// wheels by a climb, a robot read light for two samples, and the riser of the next step
+    /// of a flight, met a second later, was taken for a landing and stopped it.
     pub fn fell_within(&self, ticks: u32) -> bool {
-        self.since_hold <= ticks
+        self.dropped && self.since_hold <= ticks
     }
 }
 
@@ -202,10 +221,22 @@ mod tests {
     }
 
     #[test]
-    fn a_stall_soon_after_a_fall_is_known_as_one() {
+    fn a_stall_soon_after_a_drop_is_known_as_one_and_after_a_bounce_not() {
         let mut traction = Traction::new();
+        let landing = RATE.ticks_from_ms(TractionConfig::ROBOT.landing_ms);
+        // A bounce: light for three samples.
+        for _ in 0..3_u32 {
+            tick(&mut traction, 0.0);
+        }
+        for _ in 0..landing + 10 {
+            tick(&mut traction, 9.8);
+        }
         assert!(!traction.fell_within(1_000));
-        for _ in 0..5_u32 {
+        // Rearmed, then a drop off a 6 cm edge: 110 ms light.
+        for _ in 0..RATE.ticks_from_ms(TractionConfig::ROBOT.rearm_ms) {
+            tick(&mut traction, 9.8);
+        }
+        for _ in 0..RATE.ticks_from_ms(110) {
             tick(&mut traction, 0.0);
         }
         let landing = RATE.ticks_from_ms(TractionConfig::ROBOT.landing_ms);

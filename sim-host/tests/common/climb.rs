@@ -124,10 +124,25 @@ fn run_plan(
         riser_x_m: riser_x_m - step.plateau_m,
         depth_m: step.plateau_m,
     });
+    let mut trial = run_scene(seed, &scene, plan, (mode_at_s, latch_s), end_s);
+    trial.onto_plateau_m = riser_x_m - trial.torso_x_m;
+    trial
+}
+
+/// Runs robot `seed` of the campaign (rated drives) on `scene` through `plan` (its mode sent
+/// at `mode_at_s`, from when tilt and roll count), an E-stop latched at `latch_s` if any.
+/// [`Trial::onto_plateau_m`] is left at 0 (the caller knows where its riser is).
+pub fn run_scene(
+    seed: u64,
+    scene: &Scene,
+    plan: Vec<PlanStep>,
+    (mode_at_s, latch_s): (f64, Option<f64>),
+    end_s: f64,
+) -> Trial {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("climb")
         .join(format!("{seed}-{}", RUNS.fetch_add(1, Ordering::Relaxed)));
-    let model = mjcf::write(&scene, Path::new(DEFAULT_MODEL), &dir).unwrap();
+    let model = mjcf::write(scene, Path::new(DEFAULT_MODEL), &dir).unwrap();
     let faults = Faults::default();
     let plant = Draws::of(seed).plant(Drives::Rated.ratings());
     let mut rig = Rig::with_plant(&model, plan, &faults, &faults, plant).unwrap();
@@ -176,7 +191,7 @@ fn run_plan(
     Trial {
         fell_at,
         states,
-        onto_plateau_m: riser_x_m - torso.pos_m[0],
+        onto_plateau_m: 0.0,
         torso_z_m: torso.pos_m[2],
         max_tilt_deg,
         max_roll_deg,

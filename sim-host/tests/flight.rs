@@ -1,0 +1,88 @@
+//! A flight of two 6 cm steps up and two down, behind the robot, in the autonomous mode (`H`):
+//! it climbs the first step, backs across the 0.6 m tread into the second riser, climbs that,
+//! drives over the landing and rolls off each step down. Seeded trials over the campaign's
+//! robots as built (rated drives, real IMU and estimator, a cycle of delay), each step's
+//! height ±1 cm and the first riser 1–2 m behind the start.
+//!
+//! `cargo test --release -p sim-host --test flight -- --nocapture` prints each robot's figures.
+
+mod common;
+
+use common::climb::{run_scene, Trial, MODE_AT_S, ON_WHEELS_M};
+use firmware::control::fsm::{State, WheelMotion};
+use protocol::TeleopMode;
+use sim_host::campaign::draw::Draw;
+use sim_host::scene::{Flight, Scene};
+use teleop_core::scripted::PlanStep;
+
+/// How long a trial runs, s: two climbs of about 12 s each and the drive between and beyond.
+const END_S: f64 = 60.0;
+
+/// The largest tilt and roll a crossing may show, degrees (the figures at 6 cm).
+const MAX_TILT_DEG: f64 = 25.0;
+const MAX_ROLL_DEG: f64 = 10.0;
+
+/// Robot `seed`'s flight: two steps of 6 cm ±1 cm (one height for the flight), treads 0.6 m,
+/// a 1.2 m landing, its first riser 1–2 m behind the start.
+fn flight(seed: u64) -> Flight {
+    let mut draw = Draw::new(seed ^ 0xf117_0000);
+    let distance_m = 1.0 + draw.unit();
+    let flight = Flight {
+        rise_m: 0.05 + 0.02 * draw.unit(),
+        ..Flight::DEFAULT
+    };
+    let length_m = f64::from(flight.count - 1) * 2.0 * flight.tread_m + flight.top_depth_m;
+    Flight {
+        riser_x_m: -distance_m - length_m,
+        ..flight
+    }
+}
+
+/// Whether `trial` crossed `flight` up and down: beyond its far end, driving on in the
+/// autonomous mode on its wheels at the end, never fallen, tilted nor rolled past the limits.
+fn crossed(trial: &Trial, flight: &Flight) -> bool {
+    trial.fell_at.is_none()
+        && trial.max_tilt_deg <= MAX_TILT_DEG
+        && trial.max_roll_deg <= MAX_ROLL_DEG
+        && trial.last() == Some(State::Wheels(WheelMotion::Auto))
+        && trial.torso_z_m < ON_WHEELS_M + 0.01
+        && trial.torso_x_m < flight.riser_x_m - 0.3
+}
+
+/// The flight case: at least 80 % of the robots cross two 6 cm steps up and down, and
+/// none falls (40 robots rather than the 20: the rate is near the bound, and 20 would
+/// leave no robot to spare).
+#[test]
+fn in_the_autonomous_mode_the_robot_crosses_a_flight_of_two_6cm_steps_up_and_down() {
+    const TRIALS: u64 = 40;
+    let (mut crossings, mut fell) = (0, 0);
+    for seed in 0..TRIALS {
+        let flight = flight(seed);
+        let plan = vec![
+            PlanStep::at(0.0, TeleopMode::Fold),
+            PlanStep::at(MODE_AT_S, TeleopMode::Auto),
+        ];
+        let trial = run_scene(seed, &Scene::Flight(flight), plan, (MODE_AT_S, None), END_S);
+        let ok = crossed(&trial, &flight);
+        crossings += u64::from(ok);
+        fell += u64::from(trial.fell_at.is_some());
+        let climbs = trial
+            .states
+            .iter()
+            .filter(|(_, s)| matches!(s, State::Climbing(_)))
+            .count();
+        println!(
+            "MEASURED flight of {:.3} m steps, seed {seed}: crossed {ok}, fell {:?}, {climbs} climbs, tilt {:.1}°, roll {:.1}°, faults {:?}, ended at x {:.2} m, states {:?}",
+            flight.rise_m,
+            trial.fell_at,
+            trial.max_tilt_deg,
+            trial.max_roll_deg,
+            trial.faults,
+            trial.torso_x_m,
+            trial.states
+        );
+    }
+    println!("MEASURED flight: {crossings} of {TRIALS} crossed up and down, {fell} fell");
+    assert_eq!(fell, 0);
+    assert!(crossings * 100 >= 80 * TRIALS, "{crossings} of {TRIALS}");
+}
