@@ -382,3 +382,41 @@ fn a_run_whose_physics_diverges_leaves_its_logs_up_to_the_failure() {
         "bus.log ends at {last_frame_s} s, the run failed at {failed_s} s"
     );
 }
+
+#[test]
+fn an_autonomous_run_over_a_step_reports_the_crossing_the_climb_and_the_peak_torques() {
+    let out = scratch("auto-step");
+    let scenario = concat!(env!("CARGO_MANIFEST_DIR"), "/../scenarios/auto_step.toml");
+    let status = sim_host()
+        .args([
+            "run",
+            "--scenario",
+            scenario,
+            "--no-plots",
+            "--no-progress",
+            "--out",
+        ])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let text = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let summary: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let auto = &summary["segments"][1];
+    assert_eq!(auto["mode"], "auto");
+    // One climb, within the 20 s.
+    let climbs = auto["climbs_s"].as_array().unwrap();
+    assert_eq!(climbs.len(), 1, "{climbs:?}");
+    let climb_s = climbs[0].as_f64().unwrap();
+    assert!((5.0..=20.0).contains(&climb_s), "{climb_s} s");
+    // The step crossed: touched, a foot on it, all four feet past it.
+    let crossing = &auto["crossings"][0];
+    assert_eq!(crossing["obstacle"], "step");
+    assert!(crossing["past_s"].as_f64().is_some(), "{crossing}");
+    // The legs worked within their drives' rating (33.5 N·m peak).
+    for joint in ["hip_abduction", "hip_pitch", "knee", "ankle"] {
+        let peak = auto["torques"][joint]["peak_nm"].as_f64().unwrap();
+        assert!(peak > 1.0 && peak <= 33.5 + 1e-6, "{joint}: {peak} N·m");
+    }
+    assert_eq!(auto["fell"], false);
+}

@@ -68,6 +68,7 @@ fn trot_into_step(seed: u64, height_m: f64, approach_m: f64, backward: bool) -> 
         height_m,
         riser_x_m,
         depth_m: DEPTH_M,
+        behind: false,
     });
     let path = scene_file(&scene, &format!("seed-{seed}-{backward}"));
     let (mode, start_s) = if backward {

@@ -115,6 +115,7 @@ fn drive_w_into_step(name: &str, plant: Plant, riser_x_m: f64) -> Figures {
         height_m: 0.06,
         riser_x_m,
         depth_m: 1.2,
+        behind: false,
     });
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("stall")

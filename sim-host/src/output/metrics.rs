@@ -2,6 +2,7 @@
 //! truth: how far and which way the robot went, how much it tilted, whether it fell, whether a
 //! joint or torque went past its limit, what touched the ground, and the bus traffic.
 
+use protocol::ControllerMode;
 use serde::Serialize;
 
 use crate::output::crossings::{Crossing, CrossingTracker};
@@ -126,6 +127,10 @@ pub struct SegmentSummary {
     /// For each obstacle of the scene: when a foot first stood on it, when all four did, when
     /// all four were past it, and how long that took.
     pub crossings: Vec<Crossing>,
+    /// The controller's climbs in the segment: each climb's time from the status reporting
+    /// `Climbing` to the status leaving it, s (the last one up to the segment's end if it
+    /// still climbs).
+    pub climbs_s: Vec<f64>,
 }
 
 /// A part of the robot touching an obstacle in a segment.
@@ -157,6 +162,8 @@ pub struct SegmentTracker {
     /// counted in (a pair touches at several points).
     contact_ids: Vec<((usize, usize), u64)>,
     crossings: CrossingTracker,
+    /// When the climb under way began, s (`None`: no climb).
+    climb_since_s: Option<f64>,
 }
 
 impl SegmentTracker {
@@ -207,6 +214,7 @@ impl SegmentTracker {
                 bus: BusCounters::default(),
                 obstacle_contacts: Vec::new(),
                 crossings: Vec::new(),
+                climbs_s: Vec::new(),
             },
             start_pos: torso.pos_m,
             start_yaw: yaw,
@@ -218,6 +226,7 @@ impl SegmentTracker {
             track: Decimated::default(),
             contact_ids: Vec::new(),
             crossings: CrossingTracker::start(obstacles, sim),
+            climb_since_s: None,
         }
     }
 
@@ -231,6 +240,18 @@ impl SegmentTracker {
             - std::f64::consts::PI;
         self.last_yaw = yaw;
         s.dyaw_deg += step.to_degrees();
+        let climbing = sim.hardware().controller_mode() == Some(ControllerMode::Climbing);
+        match (climbing, self.climb_since_s) {
+            (true, None) => {
+                self.climb_since_s = Some(sim.time_s());
+                s.climbs_s.push(0.0);
+            }
+            (false, Some(_)) => self.climb_since_s = None,
+            _ => {}
+        }
+        if let (Some(since_s), Some(last)) = (self.climb_since_s, s.climbs_s.last_mut()) {
+            *last = sim.time_s() - since_s;
+        }
         s.end_s = sim.time_s();
         s.cycles += 1;
         let dx = torso.pos_m[0] - self.start_pos[0];

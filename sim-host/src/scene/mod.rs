@@ -2,7 +2,8 @@
 //! (`--scene step:height_m=0.08`, or a scenario's `[scene]` table), made into MJCF around the
 //! robot's model ([`mjcf`]).
 //!
-//! The robot starts at x = 0 facing +x. Every obstacle lies ahead of it, 3 m wide (centred on
+//! The robot starts at x = 0 facing +x. Every obstacle lies ahead of it (or behind it, x
+//! mirrored, for the autonomous mode that drives back first), 3 m wide (centred on
 //! the robot's path, so a heading off by 15° still meets it), and is a static ground geom: it
 //! collides with every part of the robot that collides with the floor — torso, wheels, thighs,
 //! shanks and feet — so a shank cannot pass through a step's edge.
@@ -43,6 +44,8 @@ pub struct Step {
     pub riser_x_m: f64,
     /// Plateau depth, m (the step down is at `riser_x_m + depth_m`).
     pub depth_m: f64,
+    /// Behind the robot instead of ahead (x mirrored): the autonomous mode drives back first.
+    pub behind: bool,
 }
 
 /// `count` steps of `rise_m` up, each tread `tread_m` deep, a landing `top_depth_m` deep, and
@@ -59,6 +62,8 @@ pub struct Flight {
     pub riser_x_m: f64,
     /// Depth of the landing at the top, m.
     pub top_depth_m: f64,
+    /// Behind the robot instead of ahead (x mirrored).
+    pub behind: bool,
 }
 
 /// A ramp of `angle_deg` and `length_m` (along its slope) from `start_x_m`, a plateau
@@ -73,6 +78,8 @@ pub struct Ramp {
     pub length_m: f64,
     /// Plateau depth at the top, m.
     pub top_depth_m: f64,
+    /// Behind the robot instead of ahead (x mirrored).
+    pub behind: bool,
 }
 
 /// The course's two obstacles; their places are fixed (see [`Course::features`]).
@@ -82,6 +89,8 @@ pub struct Course {
     pub step_height_m: f64,
     /// The ramp's slope, degrees.
     pub ramp_angle_deg: f64,
+    /// Behind the robot instead of ahead (x mirrored).
+    pub behind: bool,
 }
 
 impl Step {
@@ -91,6 +100,7 @@ impl Step {
         height_m: 0.06,
         riser_x_m: 1.0,
         depth_m: 1.2,
+        behind: false,
     };
 }
 
@@ -102,6 +112,7 @@ impl Flight {
         tread_m: 0.6,
         riser_x_m: 1.0,
         top_depth_m: 1.2,
+        behind: false,
     };
 }
 
@@ -112,6 +123,7 @@ impl Ramp {
         start_x_m: 1.0,
         length_m: 1.5,
         top_depth_m: 1.0,
+        behind: false,
     };
 }
 
@@ -120,12 +132,14 @@ impl Course {
     pub const DEFAULT: Self = Self {
         step_height_m: 0.06,
         ramp_angle_deg: 10.0,
+        behind: false,
     };
 
     /// Where the course puts its step: 1 m ahead, a 1.2 m plateau.
     pub fn step(&self) -> Step {
         Step {
             height_m: self.step_height_m,
+            behind: self.behind,
             ..Step::DEFAULT
         }
     }
@@ -136,6 +150,7 @@ impl Course {
         Ramp {
             angle_deg: self.ramp_angle_deg,
             start_x_m: step.riser_x_m + step.depth_m + 1.5,
+            behind: self.behind,
             ..Ramp::DEFAULT
         }
     }
@@ -159,6 +174,17 @@ impl Feature {
             name,
             x_m: [x0, x1],
             height_m: [height_m, height_m],
+        }
+    }
+
+    /// The feature mirrored in x (`x → −x`): the same ground met backward.
+    fn mirrored(self) -> Self {
+        let [x0, x1] = self.x_m;
+        let [h0, h1] = self.height_m;
+        Self {
+            name: self.name,
+            x_m: [-x1, -x0],
+            height_m: [h1, h0],
         }
     }
 
@@ -208,15 +234,20 @@ impl Scene {
     }
 }
 
+/// `features` mirrored in x when `behind`, in order along the path backward.
+fn placed(features: Vec<Feature>, behind: bool) -> Vec<Feature> {
+    if behind {
+        features.into_iter().map(Feature::mirrored).collect()
+    } else {
+        features
+    }
+}
+
 impl Step {
     fn features(&self, name: &str) -> Vec<Feature> {
         let x0 = self.riser_x_m;
-        vec![Feature::flat(
-            name.to_owned(),
-            x0,
-            x0 + self.depth_m,
-            self.height_m,
-        )]
+        let step = Feature::flat(name.to_owned(), x0, x0 + self.depth_m, self.height_m);
+        placed(vec![step], self.behind)
     }
 }
 
@@ -244,7 +275,7 @@ impl Flight {
             features.push(Feature::flat(name, x, x + self.tread_m, height));
             x += self.tread_m;
         }
-        features
+        placed(features, self.behind)
     }
 }
 
@@ -263,7 +294,7 @@ impl Ramp {
         let (rise, run) = (self.rise_m(), self.run_m());
         let top = self.start_x_m + run;
         let down = top + self.top_depth_m;
-        vec![
+        let features = vec![
             Feature {
                 name: format!("{name}_up"),
                 x_m: [self.start_x_m, top],
@@ -275,7 +306,8 @@ impl Ramp {
                 x_m: [down, down + run],
                 height_m: [rise, 0.0],
             },
-        ]
+        ];
+        placed(features, self.behind)
     }
 }
 
@@ -299,6 +331,23 @@ mod tests {
         let mid = ramp.start_x_m + ramp.run_m() / 2.0;
         assert!((scene.ground_height_m(mid) - ramp.rise_m() / 2.0).abs() < 1e-12);
         assert!((ramp.rise_m() - 1.5 * 10f64.to_radians().sin()).abs() < 1e-12);
+    }
+
+    #[test]
+    fn behind_the_robot_the_ground_is_mirrored() {
+        let ahead = Scene::Ramp(Ramp::DEFAULT);
+        let behind = Scene::Ramp(Ramp {
+            behind: true,
+            ..Ramp::DEFAULT
+        });
+        for x in [0.5, 1.3, 2.2, 3.0, 4.1, 5.0] {
+            let (back, front) = (behind.ground_height_m(-x), ahead.ground_height_m(x));
+            assert!(
+                (back - front).abs() < 1e-12,
+                "at {x} m: {back} against {front}"
+            );
+            assert_eq!(behind.ground_height_m(x), 0.0);
+        }
     }
 
     #[test]

@@ -226,6 +226,27 @@ impl Keys {
         Ok(value)
     }
 
+    /// `side`: `ahead` (the default) or `behind`; whether it is behind.
+    fn behind(&mut self) -> Result<bool, SceneError> {
+        let Some(g) = self.0.remove("side") else {
+            return Ok(false);
+        };
+        let text = match g.value {
+            Ok(number) => number.to_string(),
+            Err(text) => text,
+        };
+        match text.trim_matches('"') {
+            "ahead" => Ok(false),
+            "behind" => Ok(true),
+            _ => Err(SceneError::NotANumber {
+                at: g.at,
+                key: "side".to_owned(),
+                value: text,
+                expected: "give ahead or behind",
+            }),
+        }
+    }
+
     /// `key`'s number as [`Keys::take`], not whole.
     fn number(&mut self, key: &str, default: f64, range: [f64; 2]) -> Result<f64, SceneError> {
         self.take(key, default, range, false)
@@ -243,8 +264,9 @@ fn build(kind: &str, at: &str, given: BTreeMap<String, Given>) -> Result<Scene, 
                 height_m: keys.number("height_m", d.height_m, [0.005, 0.3])?,
                 riser_x_m: keys.number("riser_x_m", d.riser_x_m, [0.4, 50.0])?,
                 depth_m: keys.number("depth_m", d.depth_m, [0.1, 50.0])?,
+                behind: keys.behind()?,
             };
-            (Scene::Step(step), "height_m, riser_x_m, depth_m")
+            (Scene::Step(step), "height_m, riser_x_m, depth_m, side")
         }
         "flight" => {
             let d = Flight::DEFAULT;
@@ -255,8 +277,9 @@ fn build(kind: &str, at: &str, given: BTreeMap<String, Given>) -> Result<Scene, 
                 tread_m: keys.number("tread_m", d.tread_m, [0.1, 5.0])?,
                 riser_x_m: keys.number("riser_x_m", d.riser_x_m, [0.4, 50.0])?,
                 top_depth_m: keys.number("top_depth_m", d.top_depth_m, [0.1, 50.0])?,
+                behind: keys.behind()?,
             };
-            let known = "rise_m, count, tread_m, riser_x_m, top_depth_m";
+            let known = "rise_m, count, tread_m, riser_x_m, top_depth_m, side";
             (Scene::Flight(flight), known)
         }
         "ramp" => {
@@ -266,10 +289,11 @@ fn build(kind: &str, at: &str, given: BTreeMap<String, Given>) -> Result<Scene, 
                 start_x_m: keys.number("start_x_m", d.start_x_m, [0.4, 50.0])?,
                 length_m: keys.number("length_m", d.length_m, [0.1, 10.0])?,
                 top_depth_m: keys.number("top_depth_m", d.top_depth_m, [0.1, 50.0])?,
+                behind: keys.behind()?,
             };
             (
                 Scene::Ramp(ramp),
-                "angle_deg, start_x_m, length_m, top_depth_m",
+                "angle_deg, start_x_m, length_m, top_depth_m, side",
             )
         }
         "course" => {
@@ -277,8 +301,9 @@ fn build(kind: &str, at: &str, given: BTreeMap<String, Given>) -> Result<Scene, 
             let course = Course {
                 step_height_m: keys.number("step_height_m", d.step_height_m, [0.005, 0.3])?,
                 ramp_angle_deg: keys.number("ramp_angle_deg", d.ramp_angle_deg, [0.5, 30.0])?,
+                behind: keys.behind()?,
             };
-            (Scene::Course(course), "step_height_m, ramp_angle_deg")
+            (Scene::Course(course), "step_height_m, ramp_angle_deg, side")
         }
         other => {
             return Err(SceneError::UnknownKind {
@@ -317,6 +342,11 @@ mod tests {
             Scene::from_scenario(Path::new("s.toml"), "duration_s = 5\n").unwrap(),
             None
         );
+        let arg = Scene::from_arg("course:side=behind").unwrap();
+        let file = "duration_s = 5\n[scene]\nkind = \"course\"\nside = \"behind\"\n";
+        let toml = Scene::from_scenario(Path::new("s.toml"), file).unwrap();
+        assert_eq!(Some(arg), toml);
+        assert!(matches!(arg, Scene::Course(c) if c.behind));
     }
 
     #[test]
@@ -338,6 +368,7 @@ mod tests {
             ),
             ("step:height_m=nan", "height_m = NaN: give a number"),
             ("step:depth_m=inf", "depth_m = inf: give a number"),
+            ("step:side=left", "side = left: give ahead or behind"),
         ];
         for (arg, needle) in cases {
             let err = Scene::from_arg(arg).unwrap_err().to_string();

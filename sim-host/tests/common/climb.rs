@@ -121,8 +121,9 @@ fn run_plan(
     let riser_x_m = -step.distance_m;
     let scene = Scene::Step(Step {
         height_m: step.height_m,
-        riser_x_m: riser_x_m - step.plateau_m,
+        riser_x_m: step.distance_m,
         depth_m: step.plateau_m,
+        behind: true,
     });
     let mut trial = run_scene(seed, &scene, plan, (mode_at_s, latch_s), end_s);
     trial.onto_plateau_m = riser_x_m - trial.torso_x_m;
