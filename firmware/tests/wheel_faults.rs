@@ -126,7 +126,8 @@ fn wheels_that_do_not_turn_raise_a_stall_and_a_controlled_stop_into_fault() {
     let mut bench = Bench::on_the_wheels();
     bench.wheels = Wheels::Stuck;
     bench.send(command(TeleopMode::WheelForward));
-    // The law winds up against the blocked wheels and saturates; the saturation time trips.
+    // The law winds up against the blocked wheels: saturated, or standing still against its
+    // reference, the stall watch trips.
     let (ticks, output) = until_fault(&mut bench, ms(3_000));
     assert!(output.status.faults.contains(FaultFlags::WHEEL_STALL));
     assert!(!output.status.faults.contains(FaultFlags::RUNAWAY));

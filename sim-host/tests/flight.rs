@@ -15,7 +15,7 @@ use sim_host::campaign::draw::Draw;
 use sim_host::scene::{Flight, Scene};
 use teleop_core::scripted::PlanStep;
 
-/// How long a trial runs, s: two climbs of about 12 s each and the drive between and beyond.
+/// How long a trial runs, s: two climbs (26–30 s together) and the drive between and beyond.
 const END_S: f64 = 60.0;
 
 /// The largest tilt a crossing may show, degrees (the issue's figure at 6 cm).
@@ -57,10 +57,9 @@ fn crossed(trial: &Trial, flight: &Flight) -> bool {
 }
 
 /// The issue's flight case, two 6 cm steps up and down: none falls, and most robots cross.
-/// The issue asks 80 %; the measured rate sits on that bound (32–33 of these 40 robots, 16 of
-/// the first 20), so a change of one robot's outcome, which a rounding difference in the
-/// scene's geometry already makes, would turn it red: the test holds 75 % and prints the
-/// rate (docs/obstacles.md).
+/// The issue asks 80 %; the measured rate sits on that bound (docs/obstacles.md), so a change
+/// of one robot's outcome, which a rounding difference in the scene's geometry already makes,
+/// would turn it red: the test holds 75 % and prints the rate.
 #[test]
 fn in_the_autonomous_mode_the_robot_crosses_a_flight_of_two_6cm_steps_up_and_down() {
     const TRIALS: u64 = 40;

@@ -230,16 +230,17 @@ impl Runaway {
         let blocked = input.velocity_ref_m_s.abs() >= config.blocked_ref_m_s
             && input.ground_speed_m_s.abs() < config.blocked_m_s;
         self.blocked_ticks = count(self.blocked_ticks, blocked);
-        let tripped = self.speed_error_ticks >= speed_limit
+        let moving_wrong = self.speed_error_ticks >= speed_limit
             || self.saturated_ticks >= saturation_limit
-            || self.collision_ticks >= collision_limit
-            || self.blocked_ticks >= blocked_limit;
+            || self.collision_ticks >= collision_limit;
+        let standing = self.blocked_ticks >= blocked_limit;
         // The robot's speed does not decide it: thrown back from a step at 0.62 m/s, the
         // measured ground speed swung to 1.03 m/s and more (it adds the body's pitch rate,
         // which swings as the robot is thrown).
-        tripped.then(|| {
-            if self.struck_ticks > 0 {
-                // Thrown back by what it hit: blocked, whatever its speed says now.
+        (moving_wrong || standing).then(|| {
+            if self.struck_ticks > 0 || !moving_wrong {
+                // Thrown back by what it hit, or standing still against its reference:
+                // blocked, whichever way its speed reads within the blocked band.
                 FaultFlags::WHEEL_STALL
             } else {
                 input.cause()

@@ -62,10 +62,11 @@ pub struct Traction {
     landing_left: u32,
     /// Ticks since the last hold ended (saturating; `u32::MAX` before the first).
     since_hold: u32,
-    /// Ticks the last hold fell (not counting its landing).
+    /// Ticks the running (or last) hold fell, not counting its landing.
     fell_ticks: u32,
-    /// Whether the last hold was a drop ([`TractionConfig::drop_min_ms`]).
-    dropped: bool,
+    /// Ticks since the last hold that was a drop ([`TractionConfig::drop_min_ms`]) ended
+    /// (saturating; `u32::MAX` before the first).
+    since_drop: u32,
 }
 
 impl Traction {
@@ -77,7 +78,7 @@ impl Traction {
             landing_left: 0,
             since_hold: u32::MAX,
             fell_ticks: 0,
-            dropped: false,
+            since_drop: u32::MAX,
         }
     }
 
@@ -118,6 +119,7 @@ impl Traction {
                 0
             };
         }
+        self.since_drop = self.since_drop.saturating_add(1);
         if self.landing_left == 0 {
             self.since_hold = self.since_hold.saturating_add(1);
             return None;
@@ -132,7 +134,9 @@ impl Traction {
         } else {
             self.landing_left = self.landing_left.saturating_sub(1);
         }
-        self.dropped = self.fell_ticks >= rate.ticks_from_ms(config.drop_min_ms);
+        if self.fell_ticks >= rate.ticks_from_ms(config.drop_min_ms) {
+            self.since_drop = 0;
+        }
         self.held_ticks = self.held_ticks.saturating_add(1);
         Some(config.hold_nm_per_rad_s * (hold_rate_rad_s - rate_rad_s))
     }
@@ -147,7 +151,7 @@ impl Traction {
     /// wheels by a climb, a robot read light for two samples, and the riser of the next step
     /// of a flight, met a second later, was taken for a landing and stopped it.
     pub fn fell_within(&self, ticks: u32) -> bool {
-        self.dropped && self.since_hold <= ticks
+        self.since_drop <= ticks
     }
 }
 
@@ -221,7 +225,7 @@ mod tests {
     }
 
     #[test]
-    fn a_stall_soon_after_a_drop_is_known_as_one_and_after_a_bounce_not() {
+    fn a_stall_soon_after_a_drop_is_known_as_one_and_a_bounce_neither_counts_nor_erases_it() {
         let mut traction = Traction::new();
         let landing = RATE.ticks_from_ms(TractionConfig::ROBOT.landing_ms);
         // A bounce: light for three samples.
@@ -246,5 +250,17 @@ mod tests {
         assert!(!traction.holding());
         assert!(traction.fell_within(20));
         assert!(!traction.fell_within(5));
+        // A bounce after the drop does not make it forgotten.
+        for _ in 0..RATE.ticks_from_ms(TractionConfig::ROBOT.rearm_ms) {
+            tick(&mut traction, 9.8);
+        }
+        for _ in 0..3_u32 {
+            tick(&mut traction, 0.0);
+        }
+        for _ in 0..landing + 10 {
+            tick(&mut traction, 9.8);
+        }
+        let since_drop_ticks = RATE.ticks_from_ms(TractionConfig::ROBOT.rearm_ms) + 2 * landing;
+        assert!(traction.fell_within(since_drop_ticks + 40));
     }
 }

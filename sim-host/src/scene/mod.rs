@@ -19,7 +19,7 @@ pub use parse::SceneError;
 /// Width of every obstacle across the path, m.
 pub const OBSTACLE_WIDTH_M: f64 = 3.0;
 
-/// What a scene puts ahead of the robot.
+/// What a scene puts ahead of the robot (or behind it).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Scene {
     /// Flat ground only.
@@ -40,7 +40,7 @@ pub enum Scene {
 pub struct Step {
     /// Riser height, m.
     pub height_m: f64,
-    /// Where the riser stands, m ahead of the start.
+    /// Where the riser stands, m from the start (ahead, or behind when `behind`).
     pub riser_x_m: f64,
     /// Plateau depth, m (the step down is at `riser_x_m + depth_m`).
     pub depth_m: f64,
@@ -58,7 +58,7 @@ pub struct Flight {
     pub count: u32,
     /// Depth of each tread between risers, m.
     pub tread_m: f64,
-    /// Where the first riser stands, m ahead of the start.
+    /// Where the first riser stands, m from the start (ahead, or behind when `behind`).
     pub riser_x_m: f64,
     /// Depth of the landing at the top, m.
     pub top_depth_m: f64,
@@ -72,7 +72,7 @@ pub struct Flight {
 pub struct Ramp {
     /// Slope, degrees.
     pub angle_deg: f64,
-    /// Where the ramp leaves the ground, m ahead of the start.
+    /// Where the ramp leaves the ground, m from the start (ahead, or behind when `behind`).
     pub start_x_m: f64,
     /// Length along the slope, m.
     pub length_m: f64,

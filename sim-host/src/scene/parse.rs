@@ -46,7 +46,8 @@ pub enum SceneError {
         /// The key.
         key: String,
     },
-    /// A value that is not a number (or, for `count`, not a whole one).
+    /// A value that is not a number (or, for `count`, not a whole one; for `side`, not
+    /// `ahead` or `behind`).
     #[error("{at}: {key} = {value}: {expected}")]
     NotANumber {
         /// Where it was given.

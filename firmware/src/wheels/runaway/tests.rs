@@ -249,25 +249,31 @@ fn a_reset_starts_the_count_again_and_non_finite_input_counts_as_bad() {
 fn a_robot_standing_still_against_its_reference_trips_as_a_stall_after_the_blocked_time() {
     // Pushed softly against a riser: no collision, no saturation, the speed error under its
     // bound; only standing still does not end.
-    let mut runaway = detector();
-    let found = ticks_to_trip(&mut runaway, &input(0.01, -0.48, -9.0));
-    assert_eq!(
-        found,
-        Some((ticks(CONFIG.blocked_ms), FaultFlags::WHEEL_STALL))
-    );
+    for speed in [0.01, 0.03, -0.03] {
+        let mut runaway = detector();
+        let found = ticks_to_trip(&mut runaway, &input(speed, -0.48, -9.0));
+        let expected = Some((ticks(CONFIG.blocked_ms), FaultFlags::WHEEL_STALL));
+        assert_eq!(found, expected, "at {speed} m/s");
+    }
     // A reference under the blocked one (a creep) is left to the other rules.
     let mut runaway = detector();
     assert_eq!(ticks_to_trip(&mut runaway, &input(0.0, 0.15, 5.0)), None);
 }
 
 #[test]
-fn a_robot_starting_from_rest_behind_its_ramped_reference_does_not_trip() {
-    // The reference ramps at 0.35 m/s² and the robot follows 0.3 s behind it.
-    let mut runaway = detector();
-    for tick in 0..500_u32 {
-        let t_s = tick as f32 * 0.004;
-        let reference = f32::min(0.35 * t_s, 0.48);
-        let speed = f32::min(0.35 * f32::max(t_s - 0.3, 0.0), 0.48);
-        assert_eq!(runaway.update(&CONFIG, &input(speed, reference, 5.0)), None);
-    }
+fn a_robot_starting_from_rest_behind_its_ramped_reference_trips_only_if_it_never_moves() {
+    // The reference ramps at 0.35 m/s² (past the blocked rule's 0.2 m/s at 0.57 s); the robot
+    // follows `lag_s` behind it, under 0.05 m/s until 0.14 s after that.
+    let start = |lag_s: f32| {
+        let mut runaway = detector();
+        (0..750_u32).find_map(|tick| {
+            let t_s = tick as f32 * 0.004;
+            let reference = f32::min(0.35 * t_s, 0.48);
+            let speed = f32::min(0.35 * f32::max(t_s - lag_s, 0.0), 0.48);
+            runaway.update(&CONFIG, &input(speed, reference, 5.0))
+        })
+    };
+    assert_eq!(start(0.3), None);
+    assert_eq!(start(0.9), None);
+    assert_eq!(start(1.2), Some(FaultFlags::WHEEL_STALL));
 }
