@@ -39,10 +39,13 @@ fn flight(seed: u64) -> Flight {
     }
 }
 
-/// Where `flight` ends along the path, m (behind the start).
+/// Where `flight` ends along the path, m (behind the start): its last tread's far edge.
 fn far_end_x_m(flight: &Flight) -> f64 {
-    let length_m = f64::from(flight.count - 1) * 2.0 * flight.tread_m + flight.top_depth_m;
-    -(flight.riser_x_m + length_m)
+    Scene::Flight(*flight)
+        .features()
+        .iter()
+        .map(|feature| feature.x_m[0])
+        .fold(f64::INFINITY, f64::min)
 }
 
 /// Whether `trial` crossed `flight` up and down: beyond its far end, driving on in the

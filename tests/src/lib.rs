@@ -437,14 +437,27 @@ pub fn wait_for_log(
     timeout: Duration,
     seen: impl Fn(&[(f64, protocol::Frame)]) -> bool,
 ) -> bool {
+    let found = |frames: &[(f64, protocol::Frame)]| seen(frames).then_some(());
+    find_in_log(path, timeout, Duration::from_millis(20), found).is_some()
+}
+
+/// Polls the `candump` log at `path` every `every` until `find` finds something in its frames,
+/// at most `timeout`; what it found. A slow poll spares the CPUs a long wait shares with the
+/// processes it watches: each poll reads and decodes the whole log.
+pub fn find_in_log<T>(
+    path: &Path,
+    timeout: Duration,
+    every: Duration,
+    find: impl Fn(&[(f64, protocol::Frame)]) -> Option<T>,
+) -> Option<T> {
     let started = Instant::now();
     while started.elapsed() < timeout {
-        std::thread::sleep(Duration::from_millis(20));
-        if seen(&read_candump(path)) {
-            return true;
+        std::thread::sleep(every);
+        if let Some(found) = find(&read_candump(path)) {
+            return Some(found);
         }
     }
-    false
+    None
 }
 
 /// A test that measures timing holds this for its whole run, so that the tests of its file run

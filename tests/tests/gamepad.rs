@@ -13,7 +13,8 @@ use evdev::{
     AbsInfo, AbsoluteAxisCode, AttributeSet, EventType, InputEvent, KeyCode, UinputAbsSetup,
 };
 use hil_tests::{
-    candump, firmware, one_at_a_time, out_dir, read_candump, start_sim, wait_for_log, Process, Vcan,
+    candump, find_in_log, firmware, one_at_a_time, out_dir, read_candump, start_sim, wait_for_log,
+    Process, Vcan,
 };
 use protocol::{
     decode_frame, AnyMessage, ControllerMode, EStopAction, Frame, MessageId, TeleopMode,
@@ -135,15 +136,12 @@ fn reports(log: &Path, mode: ControllerMode, after_s: f64, timeout: Duration) ->
 
 /// When (wall clock) the controller first reported `mode` after `after_s`.
 fn reported_at(log: &Path, mode: ControllerMode, after_s: f64, timeout: Duration) -> Option<f64> {
-    let first = |frames: &[(f64, Frame)]| {
+    find_in_log(log, timeout, Duration::from_millis(20), |frames| {
         statuses(frames)
             .iter()
             .find(|&&(t, m)| t > after_s && m == mode)
             .map(|&(t, _)| t)
-    };
-    wait_for_log(log, timeout, |frames| first(frames).is_some())
-        .then(|| first(&read_candump(log)))
-        .flatten()
+    })
 }
 
 /// The simulator's control period, s: one SYNC frame per cycle.
@@ -158,19 +156,15 @@ fn run_for_sim_s(log: &Path, after_s: f64, seconds: f64) {
     let cycles = (seconds / CYCLE_S).round() as usize;
     let sync = MessageId::Sync.raw();
     let timeout = Duration::from_secs_f64(30.0 + 20.0 * seconds);
-    let started = Instant::now();
-    // Polled slowly: reading the whole log is work for the emulated CPUs the loop shares.
-    while started.elapsed() < timeout {
-        std::thread::sleep(Duration::from_millis(250));
-        let ran = read_candump(log)
+    // Polled slowly: the wait shares the emulated CPUs with what it times.
+    let ran = find_in_log(log, timeout, Duration::from_millis(250), |frames| {
+        let synced = frames
             .iter()
-            .filter(|(t, f)| *t > after_s && f.id() == sync)
-            .count();
-        if ran >= cycles {
-            return;
-        }
-    }
-    panic!(
+            .filter(|(t, f)| *t > after_s && f.id() == sync);
+        (synced.count() >= cycles).then_some(())
+    });
+    assert!(
+        ran.is_some(),
         "the simulator did not run {seconds} s in {} s of wall time (is its --duration-s long \
          enough?)",
         timeout.as_secs_f64()
