@@ -4,6 +4,7 @@ use crate::control::estimator::EstimatorConfig;
 use crate::control::heading::HeadingConfig;
 use crate::control::steering::SteeringConfig;
 use crate::control::stop::StopConfig;
+use crate::control::terrain::TerrainConfig;
 use crate::legs::blocked::BlockedConfig;
 use crate::legs::climb::ClimbConfig;
 use crate::legs::gait::TrotParams;
@@ -103,6 +104,9 @@ pub struct Config {
     /// How the autonomous mode climbs a step its wheels stall against
     /// ([`crate::legs::climb`]; `None`: the stall is a fault, as in the manual modes).
     pub climb: Option<ClimbConfig>,
+    /// Where the rangefinder sits and how its rangings are read
+    /// ([`crate::control::terrain`]).
+    pub terrain: TerrainConfig,
 }
 
 /// Per-wheel torque limit of the robot, N·m.
@@ -156,6 +160,7 @@ impl Config {
         lean: LeanConfig::ROBOT,
         blocked: BlockedConfig::ROBOT,
         climb: Some(ClimbConfig::ROBOT),
+        terrain: TerrainConfig::ROBOT,
     };
 
     /// This configuration at another control rate (gains are per second, so only the tick

@@ -120,7 +120,7 @@ const fn slot(id: MessageId, period: Period, phase: u32) -> Slot {
 /// The frames of the control loop. The balance loop (wheels, IMU) runs every cycle; the leg
 /// drives servo locally, so their targets and feedback run at 250 Hz, spread over cycles;
 /// status and operator traffic run at 50 Hz and 10 Hz in the remaining cycles.
-pub const SCHEDULE: [Slot; 20] = [
+pub const SCHEDULE: [Slot; 21] = [
     slot(MessageId::EStop, Period::Sporadic, 0),
     Slot {
         id: MessageId::Sync,
@@ -136,6 +136,7 @@ pub const SCHEDULE: [Slot; 20] = [
     slot(MessageId::LegFeedback(Leg::Fr), Period::Hz(250), 1),
     slot(MessageId::LegFeedback(Leg::Bl), Period::Hz(250), 2),
     slot(MessageId::LegFeedback(Leg::Br), Period::Hz(250), 2),
+    slot(MessageId::Range, Period::Hz(50), 4),
     slot(MessageId::TeleopCommand, Period::Hz(50), 3),
     slot(MessageId::TeleopHeartbeat, Period::Hz(50), 7),
     slot(MessageId::ControllerStatus, Period::Hz(50), 11),

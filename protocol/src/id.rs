@@ -33,6 +33,8 @@ pub enum MessageId {
     WheelFeedback,
     /// Torso IMU sample.
     Imu,
+    /// The ground behind the torso, from the rangefinder.
+    Range,
     /// Operator command (the report's keys plus stand, fold, drive, walk; height, speed scale,
     /// ground speed, yaw rate).
     TeleopCommand,
@@ -48,7 +50,7 @@ pub enum MessageId {
 
 impl MessageId {
     /// Every identifier on the bus, in priority order (highest first).
-    pub const ALL: [MessageId; 20] = [
+    pub const ALL: [MessageId; 21] = [
         MessageId::EStop,
         MessageId::Sync,
         MessageId::Announce,
@@ -60,6 +62,7 @@ impl MessageId {
         MessageId::LegFeedback(Leg::Br),
         MessageId::WheelFeedback,
         MessageId::Imu,
+        MessageId::Range,
         MessageId::TeleopCommand,
         MessageId::TeleopHeartbeat,
         MessageId::ControllerStatus,
@@ -82,6 +85,7 @@ impl MessageId {
             MessageId::LegFeedback(leg) => 0x180 + leg as u16,
             MessageId::WheelFeedback => 0x184,
             MessageId::Imu => 0x185,
+            MessageId::Range => 0x186,
             MessageId::TeleopCommand => 0x200,
             MessageId::TeleopHeartbeat => 0x201,
             MessageId::ControllerStatus => 0x400,
@@ -104,6 +108,7 @@ impl MessageId {
             0x183 => MessageId::LegFeedback(Leg::Br),
             0x184 => MessageId::WheelFeedback,
             0x185 => MessageId::Imu,
+            0x186 => MessageId::Range,
             0x200 => MessageId::TeleopCommand,
             0x201 => MessageId::TeleopHeartbeat,
             0x400 => MessageId::ControllerStatus,
@@ -128,11 +133,12 @@ impl MessageId {
             MessageId::LegFeedback(leg) => 5 + leg as usize,
             MessageId::WheelFeedback => 9,
             MessageId::Imu => 10,
-            MessageId::TeleopCommand => 11,
-            MessageId::TeleopHeartbeat => 12,
-            MessageId::ControllerStatus => 13,
-            MessageId::DriveStatus(drive) => 14 + drive as usize,
-            MessageId::RejectCounters => 19,
+            MessageId::Range => 11,
+            MessageId::TeleopCommand => 12,
+            MessageId::TeleopHeartbeat => 13,
+            MessageId::ControllerStatus => 14,
+            MessageId::DriveStatus(drive) => 15 + drive as usize,
+            MessageId::RejectCounters => 20,
         }
     }
 
@@ -158,6 +164,7 @@ impl MessageId {
                 NodeId::LegDriveBr,
                 NodeId::WheelDrive,
                 NodeId::Imu,
+                NodeId::Rangefinder,
                 NodeId::Teleop,
             ],
             MessageId::ControllerStatus => &[
@@ -184,6 +191,7 @@ impl MessageId {
             MessageId::LegFeedback(_)
             | MessageId::WheelFeedback
             | MessageId::Imu
+            | MessageId::Range
             | MessageId::TeleopCommand
             | MessageId::TeleopHeartbeat
             | MessageId::DriveStatus(_) => &[NodeId::Controller],

@@ -19,6 +19,7 @@
 //! | `0x180`–`0x183` | [`LegFeedback`] FL, FR, BL, BR | leg drives | feedback | 250 Hz          |
 //! | `0x184`         | [`WheelFeedback`]    | wheel drive  | feedback    | every cycle           |
 //! | `0x185`         | [`Imu`]              | IMU          | feedback    | every cycle           |
+//! | `0x186`         | [`Range`]            | rangefinder  | feedback    | 50 Hz                 |
 //! | `0x200`         | [`TeleopCommand`]    | teleop       | teleop      | on change, ≤ 50 Hz    |
 //! | `0x201`         | [`TeleopHeartbeat`]  | teleop       | teleop      | 50 Hz                 |
 //! | `0x400`         | [`ControllerStatus`] | controller   | status      | 50 Hz                 |

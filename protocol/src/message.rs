@@ -7,8 +7,8 @@ use crate::error::DecodeError;
 use crate::frame::Frame;
 use crate::id::MessageId;
 use crate::msg::{
-    Announce, ControllerStatus, DriveStatus, EStop, Imu, LegFeedback, LegTargets, RejectCounters,
-    Sync, TeleopCommand, TeleopHeartbeat, WheelCommand, WheelFeedback,
+    Announce, ControllerStatus, DriveStatus, EStop, Imu, LegFeedback, LegTargets, Range,
+    RejectCounters, Sync, TeleopCommand, TeleopHeartbeat, WheelCommand, WheelFeedback,
 };
 use crate::msg::{CLASSIC_LATCH_LEN, LATCH_CHECKED_LEN};
 use crate::node::{Drive, Leg};
@@ -28,6 +28,7 @@ pub enum AnyMessage {
     LegFeedback(Leg, LegFeedback),
     WheelFeedback(WheelFeedback),
     Imu(Imu),
+    Range(Range),
     TeleopCommand(TeleopCommand),
     TeleopHeartbeat(TeleopHeartbeat),
     ControllerStatus(ControllerStatus),
@@ -73,6 +74,7 @@ pub fn decode_frame(raw_id: u16, data: &[u8]) -> Result<Decoded, DecodeError> {
             decode(id, data).map(|(m, c)| (AnyMessage::WheelFeedback(m), c))?
         }
         MessageId::Imu => decode(id, data).map(|(m, c)| (AnyMessage::Imu(m), c))?,
+        MessageId::Range => decode(id, data).map(|(m, c)| (AnyMessage::Range(m), c))?,
         MessageId::TeleopCommand => {
             decode(id, data).map(|(m, c)| (AnyMessage::TeleopCommand(m), c))?
         }
@@ -145,6 +147,7 @@ impl AnyMessage {
             AnyMessage::LegFeedback(leg, _) => MessageId::LegFeedback(*leg),
             AnyMessage::WheelFeedback(_) => MessageId::WheelFeedback,
             AnyMessage::Imu(_) => MessageId::Imu,
+            AnyMessage::Range(_) => MessageId::Range,
             AnyMessage::TeleopCommand(_) => MessageId::TeleopCommand,
             AnyMessage::TeleopHeartbeat(_) => MessageId::TeleopHeartbeat,
             AnyMessage::ControllerStatus(_) => MessageId::ControllerStatus,
@@ -174,6 +177,7 @@ impl AnyMessage {
             AnyMessage::LegFeedback(leg, m) => encode_keyed(m, *leg, session, key, counter),
             AnyMessage::WheelFeedback(m) => encode_keyed(m, (), session, key, counter),
             AnyMessage::Imu(m) => encode_keyed(m, (), session, key, counter),
+            AnyMessage::Range(m) => encode_keyed(m, (), session, key, counter),
             AnyMessage::TeleopCommand(m) => encode_keyed(m, (), session, key, counter),
             AnyMessage::TeleopHeartbeat(m) => encode_keyed(m, (), session, key, counter),
             AnyMessage::ControllerStatus(m) => encode_keyed(m, (), session, key, counter),
@@ -229,6 +233,7 @@ impl MessageId {
             }),
             MessageId::WheelFeedback => layout::<WheelFeedback>(WheelFeedback::NAME),
             MessageId::Imu => layout::<Imu>(Imu::NAME),
+            MessageId::Range => layout::<Range>(Range::NAME),
             MessageId::TeleopCommand => layout::<TeleopCommand>(TeleopCommand::NAME),
             MessageId::TeleopHeartbeat => layout::<TeleopHeartbeat>(TeleopHeartbeat::NAME),
             MessageId::ControllerStatus => layout::<ControllerStatus>(ControllerStatus::NAME),
@@ -259,6 +264,7 @@ impl MessageId {
             MessageId::LegFeedback(leg) => leg.drive().node(),
             MessageId::WheelFeedback => NodeId::WheelDrive,
             MessageId::Imu => NodeId::Imu,
+            MessageId::Range => NodeId::Rangefinder,
             MessageId::DriveStatus(drive) => drive.node(),
         }
     }

@@ -24,11 +24,13 @@ pub enum NodeId {
     Simulator = 9,
     /// A tool outside the system, e.g. `cansend` run by an operator.
     Tool = 10,
+    /// The rangefinder looking at the ground behind the torso.
+    Rangefinder = 11,
 }
 
 impl NodeId {
     /// Every node, in id order.
-    pub const ALL: [NodeId; 10] = [
+    pub const ALL: [NodeId; 11] = [
         NodeId::Controller,
         NodeId::LegDriveFl,
         NodeId::LegDriveFr,
@@ -39,6 +41,7 @@ impl NodeId {
         NodeId::Teleop,
         NodeId::Simulator,
         NodeId::Tool,
+        NodeId::Rangefinder,
     ];
 
     /// The node with this raw id, or `None` if no node has it.
@@ -54,6 +57,7 @@ impl NodeId {
             8 => NodeId::Teleop,
             9 => NodeId::Simulator,
             10 => NodeId::Tool,
+            11 => NodeId::Rangefinder,
             _ => return None,
         })
     }
@@ -71,6 +75,7 @@ impl NodeId {
             NodeId::Teleop => "Teleop",
             NodeId::Simulator => "Simulator",
             NodeId::Tool => "Tool",
+            NodeId::Rangefinder => "Rangefinder",
         }
     }
 }
@@ -192,7 +197,7 @@ impl crate::signal::WireField for NodeId {
     const EXP10: i8 = 0;
     const UNIT: &'static str = "";
     const RAW_MIN: i64 = 1;
-    const RAW_MAX: i64 = 10;
+    const RAW_MAX: i64 = 11;
     const VALUES: &'static [(u32, &'static str)] = &[
         (1, "Controller"),
         (2, "LegDrive_FL"),
@@ -204,5 +209,6 @@ impl crate::signal::WireField for NodeId {
         (8, "Teleop"),
         (9, "Simulator"),
         (10, "Tool"),
+        (11, "Rangefinder"),
     ];
 }

@@ -60,6 +60,11 @@ wire_scalar!(
     YawRate(i16) = I16, exp10 -3, unit "rad/s", raw -3_000, 3_000
 );
 wire_scalar!(
+    /// Distance measured by a rangefinder. 1e-3 m, `u16`, accepted 0…4000 (0…4 m: the
+    /// VL53L1X's longest range; it reports whole millimetres).
+    RangeDistance(u16) = U16, exp10 -3, unit "m", raw 0, 4_000
+);
+wire_scalar!(
     /// Control tick count. 1 tick, `u32`; wraps after 2^32 ticks (49.7 days at 1 kHz).
     Tick(u32) = U32, exp10 0, unit "tick", raw 0, u32::MAX
 );
@@ -152,6 +157,16 @@ impl Tick {
         Self(self.0.wrapping_add(1))
     }
 }
+
+wire_enum!(
+    /// Whether a rangefinder's distance holds, with the VL53L1X's codes (its `RangeStatus`).
+    RangeStatus {
+        /// A target within range: the distance holds.
+        Valid = 0 => "Valid",
+        /// No return strong enough (nothing within range): the distance means nothing.
+        SignalFail = 2 => "SignalFail",
+    }
+);
 
 wire_enum!(
     /// What an E-stop frame asks for.

@@ -96,6 +96,14 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
                 );
             }
         }
+        AnyMessage::Range(m) => {
+            put(
+                "distance".into(),
+                f64::from(m.distance.si()),
+                RangeDistance::STEP,
+            );
+            put("status".into(), f64::from(m.status.raw()), 1.0);
+        }
         AnyMessage::TeleopCommand(m) => {
             put("mode".into(), f64::from(m.mode.raw()), 1.0);
             put(

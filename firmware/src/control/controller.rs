@@ -15,6 +15,7 @@ mod blocked;
 mod carrier;
 mod climbing;
 mod folding;
+mod riding;
 mod status;
 mod stopping;
 mod supervise;
@@ -33,7 +34,6 @@ use crate::control::sensors::Sensors;
 use crate::control::stop::Stop;
 use crate::control::teleop::Teleop;
 use crate::legs::blocked::BlockedSwings;
-use crate::legs::climb::Climb;
 use crate::legs::gait::Trot;
 use crate::legs::kinematics::LegJoints;
 use crate::legs::levelling::Levelling;
@@ -46,6 +46,7 @@ use crate::wheels::lean::LeanWatch;
 use crate::wheels::runaway::Runaway;
 use crate::wheels::traction::Traction;
 use crate::wheels::wheel::SpeedLoop;
+use climbing::Autonomy;
 
 /// How fast the turn reference changes, rad/s² of wheel rate: a step to the turn's full
 /// rate asked the turn loop for its whole torque at once, and on low friction the wheels slipped
@@ -132,18 +133,8 @@ pub struct Controller {
     walk_direction: Direction,
     /// The trot's heading hold, and the yaw rate it gives the trot this tick, rad/s.
     heading: (HeadingHold, f32),
-    /// The climb under way (`State::Climbing(_)`; `None` otherwise).
-    climb: Option<Climb>,
-    /// Whether the running fold follows a climb that set the robot on its wheels.
-    climbed: bool,
-    /// Whether a climb has set the robot on top of something and it has stayed on its wheels
-    /// since: it then carries its front legs clear of the drop it will meet
-    /// ([`Controller::with_front_clear`]). Not before: started from that pose, the climb of
-    /// a 9–11 cm step it cannot take put 26 of 50 robots down on their torsos instead of 6.
-    on_top: bool,
-    /// Whether the autonomous mode gave up a climb: reported until the operator's next
-    /// request.
-    step_refused: bool,
+    /// The autonomous mode's climbs (see [`Autonomy`]).
+    auto: Autonomy,
 }
 
 impl Controller {
@@ -194,10 +185,7 @@ impl Controller {
             leg_blocked: false,
             walk_direction: Direction::Forward,
             heading: (HeadingHold::default(), 0.0),
-            climb: None,
-            climbed: false,
-            on_top: false,
-            step_refused: false,
+            auto: Autonomy::default(),
         })
     }
 
@@ -242,6 +230,7 @@ impl Controller {
             AnyMessage::LegFeedback(leg, feedback) => self.sensors.record_leg(now, *leg, feedback),
             AnyMessage::WheelFeedback(feedback) => self.sensors.record_wheels(now, feedback),
             AnyMessage::Imu(imu) => self.sensors.record_imu(now, imu),
+            AnyMessage::Range(range) => self.sensors.record_range(range),
             AnyMessage::TeleopHeartbeat(_) => self.teleop.heartbeat(now),
             AnyMessage::TeleopCommand(command) => {
                 if let Some(mode) = self.teleop.command(now, command) {
@@ -285,6 +274,7 @@ impl Controller {
             self.follow_measured();
         }
         let dt_s = self.config.rate.period_s();
+        self.ride_step(now, dt_s);
         let depth_m = self.config.posture.depth_for(self.teleop.body_height_m);
         let previous = self.legs_rad;
         let mut legs_enabled = self.armed;
@@ -386,7 +376,7 @@ impl Controller {
         {
             // The operator has seen the stop and asks for something: the report has served.
             self.leg_blocked = false;
-            self.step_refused = false;
+            self.auto.step_refused = false;
         }
         let next = self.state.next(event);
         if next == self.state {
@@ -418,7 +408,7 @@ impl Controller {
             self.teleop.interlock();
         }
         if !matches!(next, State::Climbing(_)) {
-            self.climb = None;
+            self.auto.climb = None;
         }
         if next != State::EStop {
             self.stop = None;
@@ -444,7 +434,7 @@ impl Controller {
             self.fold_ahead_m = 0.0;
             self.fold_return = None;
             self.fold_done_at = None;
-            self.climbed = false;
+            self.auto.climbed = false;
         }
         self.climb_flags_into(next);
         let moving_on_wheels = matches!(self.state, State::Wheels(motion) if motion.moving());

@@ -13,3 +13,4 @@ pub mod sensors;
 pub mod steering;
 pub mod stop;
 pub mod teleop;
+pub mod terrain;

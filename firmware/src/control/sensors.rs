@@ -1,7 +1,7 @@
 //! The latest feedback from the drives and the IMU, in SI units, with a watchdog per source.
 //! The IMU sends rate and specific force; the attitude is the [`AttitudeEstimator`]'s.
 
-use protocol::{Imu, Joints, Leg, LegFeedback, WheelFeedback};
+use protocol::{Imu, Joints, Leg, LegFeedback, Range, RangeStatus, WheelFeedback};
 
 use crate::attitude::Attitude;
 use crate::control::estimator::{AttitudeEstimator, EstimatorConfig, Motion};
@@ -27,6 +27,8 @@ pub struct Sensors {
     /// The IMU sample received this tick, for [`Sensors::estimate`] (as it came: 12 bytes, not
     /// the 24 of its values in SI units).
     imu_sample: Option<(Tick, Imu)>,
+    /// The rangefinder's ranging received this tick: its distance, m (`None`: no return).
+    range_sample: Option<Option<f32>>,
     legs: [Watchdog; 4],
     wheels: Watchdog,
     imu: Watchdog,
@@ -48,6 +50,7 @@ impl Sensors {
             angular_rate_rad_s: [0.0; 3],
             estimator,
             imu_sample: None,
+            range_sample: None,
             legs: [Watchdog::new(feedback_ticks); 4],
             wheels: Watchdog::new(feedback_ticks),
             imu: Watchdog::new(imu_ticks),
@@ -80,6 +83,20 @@ impl Sensors {
             self.imu_sample = Some((now, *imu));
             self.imu.feed(now);
         }
+    }
+
+    /// Keeps a ranging for this tick's [`Sensors::take_range`].
+    pub fn record_range(&mut self, range: &Range) {
+        self.range_sample = Some(match range.status {
+            RangeStatus::Valid => Some(range.distance.si()),
+            RangeStatus::SignalFail => None,
+        });
+    }
+
+    /// The ranging received this tick, if any: `Some(Some(m))` a distance, `Some(None)` no
+    /// return within the part's range.
+    pub fn take_range(&mut self) -> Option<Option<f32>> {
+        self.range_sample.take()
     }
 
     /// Runs this tick's IMU sample, if any, through the attitude estimator (configured as

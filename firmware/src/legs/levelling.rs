@@ -57,6 +57,17 @@ pub struct FoldFamily {
     /// back under the hips they cleared 13 cm, but robots then balanced up to 11° nose down
     /// and some ran into a limit cycle on the plateau: 46 of 50 crossed instead of 49.)
     pub front_clear: LegJoints,
+    /// Front legs riding in the autonomous mode on its wheels (the left leg's; the right one
+    /// mirrors its abduction): swung back under the torso, knees at their stop, spread
+    /// outward, so that they clear a 10° ramp's foot as the robot comes off it back first,
+    /// leaning 12° uphill beyond its balance point (the tucked fold hung them 4 cm lower
+    /// there, and robots whose balance point was 10° nose down ran their shanks into the
+    /// slope).
+    pub ride_front: LegJoints,
+    /// Back legs riding in the autonomous mode: under the hips, knees at their stop, spread:
+    /// they lead up a ramp, where the tucked fold's shanks, 0.45 m behind the axle, met the
+    /// slope. Their mass moves forward as the front legs' moves back.
+    pub ride_back: LegJoints,
 }
 
 const fn leg(hip_pitch_deg: f32, knee_deg: f32, ankle_deg: f32) -> LegJoints {
@@ -82,6 +93,14 @@ impl FoldFamily {
         front_clear: LegJoints {
             hip_abduction_rad: deg_to_rad(34.0),
             ..leg(50.0, -110.0, -40.0)
+        },
+        ride_front: LegJoints {
+            hip_abduction_rad: deg_to_rad(34.0),
+            ..leg(-50.0, -110.0, 0.0)
+        },
+        ride_back: LegJoints {
+            hip_abduction_rad: deg_to_rad(34.0),
+            ..leg(0.0, -110.0, -40.0)
         },
     };
 

@@ -111,6 +111,12 @@ pub struct Balance {
     /// Whether the trim may follow the balance point now (see
     /// [`Balance::set_trim_following`]).
     following: bool,
+    /// Time constant in which a position error the robot is making up is forgiven instead,
+    /// s (`None`: it is made up; see [`Balance::set_forgiving`]).
+    forgive_s: Option<f32>,
+    /// How far from the trim a balance point may lie for the trim to follow it, rad (`None`:
+    /// any; see [`Balance::set_trim_band`]).
+    follow_band_rad: Option<f32>,
     /// Whether the trim followed the balance point on the last update.
     followed: bool,
     /// Whether a robot at rest holds its place while the trim changes (see
@@ -135,6 +141,8 @@ impl Balance {
             accel_m_s2: 0.0,
             learning: false,
             following: false,
+            follow_band_rad: None,
+            forgive_s: None,
             followed: false,
             holding_place: false,
             rest_s: 0.0,
@@ -163,6 +171,26 @@ impl Balance {
     /// deliberate position error does not mislead it).
     pub fn set_trim_following(&mut self, following: bool) {
         self.following = following;
+    }
+
+    /// Bounds how far from the trim a balance point the trim follows may lie (`None`: no
+    /// bound). The lean shows the balance point only on level ground: on a slope the wheels
+    /// hold the robot with a torque whose reaction leans the body (12° on 10°), the trim took
+    /// that lean for the balance point, the law moved its position error with it and ran the
+    /// robot down the slope. A robot whose trim was learned on the flat passes a bound that
+    /// a slope's lean exceeds and its own legs' slow changes do not.
+    pub fn set_trim_band(&mut self, band_rad: Option<f32>) {
+        self.follow_band_rad = band_rad;
+    }
+
+    /// Forgives, with time constant `tau_s`, a position error the robot is making up (`None`:
+    /// it is made up, the law's way of holding a place or a distance). Up a slope the law
+    /// falls behind its reference and needs the position error's torque to climb at all; past
+    /// the crest it then ran the robot down the far side 50 % over its reference speed to
+    /// make up the distance, tilted 24°. A robot that only has to drive on (the autonomous
+    /// mode) keeps the error while it is behind and forgets it once it has caught up.
+    pub fn set_forgiving(&mut self, tau_s: Option<f32>) {
+        self.forgive_s = tau_s;
     }
 
     /// One step of the trim learning: while the robot is asked to stand, and either has been
@@ -201,7 +229,10 @@ impl Balance {
         let balance_point_rad = input.pitch_rad - self.config.lean_rad_per_m_s2 * self.accel_m_s2;
         let error_rad = balance_point_rad - self.trim_rad;
         let tau_s = self.config.trim_follow_time_constant_s;
-        self.followed = self.following && steady && error_rad.is_finite() && tau_s > 0.0;
+        let within = self
+            .follow_band_rad
+            .is_none_or(|band_rad| error_rad.abs() <= band_rad);
+        self.followed = self.following && steady && within && error_rad.is_finite() && tau_s > 0.0;
         if self.followed {
             self.take_trim(error_rad, dt_s / tau_s, false);
         }
@@ -388,6 +419,12 @@ impl Balance {
         let grows = torque_at(candidate).abs() > torque_at(self.position_error_m).abs();
         if !(saturated && grows) {
             self.position_error_m = candidate;
+        }
+        if let Some(tau_s) = self.forgive_s.filter(|tau_s| *tau_s > 0.0) {
+            // Made up when the robot runs ahead of its reference against the error's sign.
+            if self.position_error_m * speed_error < 0.0 {
+                self.position_error_m *= 1.0 - crate::math::clamp(dt_s / tau_s, 0.0, 1.0);
+            }
         }
         // In a steady state the past torques equal the present one, so the law gives
         // `(−K_x x + ff) / (1 + Σ k_u)`: the feed-forward is scaled up by as much.

@@ -118,6 +118,10 @@ impl RunawayInput {
     }
 }
 
+/// How many times [`RunawayConfig::blocked_ms`] a patient watch waits (see
+/// [`Runaway::set_patient`]).
+pub const PATIENT_FACTOR: u32 = 4;
+
 /// Counts how long the balance law has been out of bounds.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Runaway {
@@ -139,6 +143,9 @@ pub struct Runaway {
     /// Ticks the robot has stood still against a speed reference (see
     /// [`RunawayConfig::blocked_ms`]).
     blocked_ticks: u32,
+    /// Whether standing still against the reference is given [`PATIENT_FACTOR`] times as long
+    /// (see [`Runaway::set_patient`]).
+    patient: bool,
     /// Last tick's speed error, m/s (NaN: none yet), and the filtered rate it changes, m/s².
     last_error_m_s: f32,
     error_rate_m_s2: f32,
@@ -167,10 +174,19 @@ impl Runaway {
                 ticks(config.blocked_ms),
             ],
             blocked_ticks: 0,
+            patient: false,
             last_error_m_s: f32::NAN,
             error_rate_m_s2: 0.0,
             period_s: rate.period_s(),
         }
+    }
+
+    /// Gives a robot standing still against its reference [`PATIENT_FACTOR`] times
+    /// [`RunawayConfig::blocked_ms`] (`patient`) or that (not). A robot starting from rest up
+    /// a slope leans into it for a second or more before it rolls (1.2 s on a 10° ramp), and
+    /// one that rides clear of a slope has been told by its rangefinder that no riser is near.
+    pub fn set_patient(&mut self, patient: bool) {
+        self.patient = patient;
     }
 
     /// Forgets what it counted (when the balance law stops or starts).
@@ -233,6 +249,11 @@ impl Runaway {
         let moving_wrong = self.speed_error_ticks >= speed_limit
             || self.saturated_ticks >= saturation_limit
             || self.collision_ticks >= collision_limit;
+        let blocked_limit = if self.patient {
+            blocked_limit.saturating_mul(PATIENT_FACTOR)
+        } else {
+            blocked_limit
+        };
         let standing = self.blocked_ticks >= blocked_limit;
         // The robot's speed does not decide it: thrown back from a step at 0.62 m/s, the
         // measured ground speed swung to 1.03 m/s and more (it adds the body's pitch rate,

@@ -8,6 +8,7 @@ mod estop;
 mod imu;
 mod leg_feedback;
 mod leg_targets;
+mod range;
 mod reject_counters;
 mod sync;
 mod teleop_command;
@@ -24,6 +25,7 @@ pub use estop::{
 pub use imu::Imu;
 pub use leg_feedback::LegFeedback;
 pub use leg_targets::LegTargets;
+pub use range::Range;
 pub use reject_counters::RejectCounters;
 pub use sync::Sync;
 pub use teleop_command::TeleopCommand;

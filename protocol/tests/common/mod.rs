@@ -97,6 +97,12 @@ pub fn any_message() -> impl Strategy<Value = AnyMessage> {
                 angular_rate,
                 acceleration
             })),
+        (0_u16..=4_000, pick(RangeStatus::ALL)).prop_map(|(mm, status)| {
+            AnyMessage::Range(Range {
+                distance: RangeDistance::from_raw(mm).unwrap(),
+                status,
+            })
+        }),
         (
             pick(TeleopMode::ALL),
             height(),

@@ -1,6 +1,7 @@
-//! All emulated nodes of the robot together — four leg drives, the wheel drive, the IMU — and
-//! the bus schedule they follow ([`protocol::busload::SCHEDULE`]): wheel feedback and IMU every
-//! cycle, leg feedback at 250 Hz, drive status at 10 Hz.
+//! All emulated nodes of the robot together — four leg drives, the wheel drive, the IMU, the
+//! rangefinder — and the bus schedule they follow ([`protocol::busload::SCHEDULE`]): wheel
+//! feedback and IMU every cycle, leg feedback at 250 Hz, rangings at 50 Hz, drive status at
+//! 10 Hz.
 //!
 //! The simulator also listens to the controller's status frames, as any bus observer can, to
 //! label its telemetry with the controller's mode.
@@ -15,6 +16,7 @@ use crate::robot::imu::ImuNode;
 use crate::robot::leg_drive::LegDrive;
 use crate::robot::physics::Physics;
 use crate::robot::plant::Plant;
+use crate::robot::rangefinder::RangeNode;
 use crate::robot::wheel_drive::WheelDrive;
 
 /// The frames the nodes send in one cycle: at most one per slot of the schedule, held without
@@ -27,6 +29,7 @@ pub struct Hardware {
     legs: [LegDrive; 4],
     wheel: WheelDrive,
     imu: ImuNode,
+    range: RangeNode,
     control_hz: u32,
     controller_mode: Option<ControllerMode>,
 }
@@ -47,6 +50,7 @@ impl Hardware {
                 .rated(plant.drives.wheel)
                 .sensing(&plant.sensing),
             imu: ImuNode::new(plant.imu, plant.imu_noise, key),
+            range: RangeNode::new(plant.rangefinder, key),
             control_hz,
             controller_mode: None,
         }
@@ -65,6 +69,11 @@ impl Hardware {
     /// The IMU node.
     pub fn imu(&self) -> &ImuNode {
         &self.imu
+    }
+
+    /// The rangefinder node.
+    pub fn rangefinder(&self) -> &RangeNode {
+        &self.range
     }
 
     /// The controller's mode from its last status frame.
@@ -94,6 +103,7 @@ impl Hardware {
         }
         self.wheel.on_frame(now_us, frame);
         self.imu.on_frame(frame);
+        self.range.on_frame(frame);
         if frame.id() == MessageId::ControllerStatus.raw() {
             if let Ok(decoded) = decode_frame(frame.id(), frame.data()) {
                 if let AnyMessage::ControllerStatus(status) = decoded.message {
@@ -129,6 +139,7 @@ impl Hardware {
         physics: &Physics,
     ) -> Result<FramesDue, EncodeError> {
         let mut frames = FramesDue::new();
+        self.range.observe(physics);
         for slot in SCHEDULE
             .iter()
             .filter(|s| s.sends_in(cycle, self.control_hz))
@@ -146,6 +157,10 @@ impl Hardware {
                 MessageId::Imu => {
                     let message = self.imu.sample(now_us, physics);
                     self.imu.seal(&message)?
+                }
+                MessageId::Range => {
+                    let message = self.range.ranging(physics);
+                    self.range.seal(&message)?
                 }
                 MessageId::DriveStatus(drive) => {
                     let core = match drive {

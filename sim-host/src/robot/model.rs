@@ -107,6 +107,8 @@ pub struct Layout {
     pub imu_gyro: usize,
     /// Accelerometer.
     pub imu_accel: usize,
+    /// `sensordata` address of each rangefinder ray (centre, up, down, left, right).
+    pub range_rays: [usize; 5],
     /// `sensordata` address of each foot's touch sensor (FL, FR, BL, BR).
     pub foot_touch: [usize; 4],
     /// The torso body.
@@ -146,6 +148,13 @@ impl Layout {
             imu_quat: find.sensor("imu_quat", 4)?,
             imu_gyro: find.sensor("imu_gyro", 3)?,
             imu_accel: find.sensor("imu_accel", 3)?,
+            range_rays: [
+                find.sensor("range_c", 1)?,
+                find.sensor("range_up", 1)?,
+                find.sensor("range_down", 1)?,
+                find.sensor("range_l", 1)?,
+                find.sensor("range_r", 1)?,
+            ],
             foot_touch: [0; 4],
             torso_body: find.id("body", MjtObj::mjOBJ_BODY, "torso")?,
             wheel_geoms: [find.geom("wheel_left")?, find.geom("wheel_right")?],

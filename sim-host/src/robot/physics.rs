@@ -222,6 +222,14 @@ impl Physics {
             .map(|adr| self.data.sensordata()[adr])
     }
 
+    /// The rangefinder's rays' exact lengths to what they meet first, m (centre, up, down,
+    /// left, right; −1: nothing).
+    pub fn range_rays_m(&self) -> [f64; 5] {
+        self.layout
+            .range_rays
+            .map(|adr| self.data.sensordata()[adr])
+    }
+
     /// The IMU's ideal readings: orientation world ← torso (w x y z), body-frame angular rate
     /// (rad/s), body-frame specific force (m/s²).
     pub fn imu(&self) -> ([f64; 4], [f64; 3], [f64; 3]) {

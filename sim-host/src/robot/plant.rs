@@ -7,6 +7,7 @@ use host_can::fault_plan::Faults;
 
 use crate::robot::imu::{ImuModel, ImuNoise};
 use crate::robot::imu_chip::ChipSpec;
+use crate::robot::rangefinder::{RangeModel, RangeSpec};
 use crate::robot::rating::Rating;
 use crate::robot::sensing::DriveSensing;
 use crate::robot::variation::Variation;
@@ -42,6 +43,8 @@ pub struct Plant {
     pub imu: ImuModel,
     /// Extra noise and bias on the IMU, and the seed of its chip.
     pub imu_noise: ImuNoise,
+    /// The rangefinder's part (or a perfect one).
+    pub rangefinder: RangeModel,
     /// What the drives can deliver.
     pub drives: DriveRatings,
     /// How the drives measure their joints.
@@ -72,7 +75,8 @@ impl Default for Plant {
     /// The tested default: the IMU is a real chip ([`ChipSpec::BMI088`]), the part drawn with
     /// seed 1 — the same chip as `sim-host run`'s default `--seed 1` (see `docs/simulator.md`
     /// for what other draws do to the acceptance figures) — and rated drives
-    /// ([`DriveRatings::RATED`]) that measure with real encoders ([`DriveSensing::REAL`]), on a
+    /// ([`DriveRatings::RATED`]) that measure with real encoders ([`DriveSensing::REAL`]), a
+    /// VL53L1X rangefinder ([`RangeSpec::VL53L1X`], the part drawn with seed 1), on a
     /// bus that holds every frame back a cycle each way (a real CAN loop's transport delay).
     fn default() -> Self {
         Self {
@@ -80,6 +84,10 @@ impl Default for Plant {
             imu_noise: ImuNoise {
                 seed: 1,
                 ..ImuNoise::default()
+            },
+            rangefinder: RangeModel::Part {
+                spec: RangeSpec::VL53L1X,
+                seed: 1,
             },
             drives: DriveRatings::RATED,
             sensing: DriveSensing::REAL,

@@ -41,7 +41,7 @@ impl BusStatus {
                 self.wheel_speed_rad_s = Some((now_ms, wheels.velocity.map(|v| v.si())));
                 self.last_feedback_ms = Some(now_ms);
             }
-            AnyMessage::LegFeedback(..) | AnyMessage::Imu(_) => {
+            AnyMessage::LegFeedback(..) | AnyMessage::Imu(_) | AnyMessage::Range(_) => {
                 self.last_feedback_ms = Some(now_ms)
             }
             AnyMessage::DriveStatus(drive, status) => {

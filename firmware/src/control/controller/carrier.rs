@@ -101,7 +101,7 @@ impl Controller {
     /// the ground to be one level, would read the robot as standing on its feet.
     pub(super) fn wheels_carry(&self) -> bool {
         matches!(self.state, State::Wheels(_))
-            || (self.climbed && matches!(self.state, State::Folding(_)))
+            || (self.auto.climbed && matches!(self.state, State::Folding(_)))
             || self
                 .leg_stance
                 .is_some_and(|stance| self.config.support.grounds_wheels(&stance))

@@ -13,12 +13,38 @@ use crate::legs::crawl::frame::PerLeg;
 use crate::legs::kinematics::{leg_fk, LegJoints};
 use crate::time::Tick;
 
+use super::riding::Riding;
+
+/// What the autonomous mode keeps of its climbs and of the ground it rides.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(super) struct Autonomy {
+    /// The climb under way (`State::Climbing(_)`; `None` otherwise).
+    pub(super) climb: Option<Climb>,
+    /// Whether the running fold follows a climb that set the robot on its wheels.
+    pub(super) climbed: bool,
+    /// Whether a climb has set the robot on top of something and it has stayed on its wheels
+    /// since: it then carries its front legs clear of the drop it will meet
+    /// ([`crate::legs::levelling::FoldFamily::front_clear`]). Not before: started from that
+    /// pose, the climb of a 9–11 cm step it cannot take put 26 of 50 robots down on their
+    /// torsos instead of 6.
+    pub(super) on_top: bool,
+    /// Whether the autonomous mode gave up a climb: reported until the operator's next
+    /// request.
+    pub(super) step_refused: bool,
+    /// The legs' pose for the ground behind (see [`Riding`]).
+    pub(super) riding: Riding,
+}
+
 impl Controller {
-    /// A stall on the wheels at `now`: in the autonomous mode with a climb configured, the
-    /// climb starts (`true`); otherwise the caller faults (a manual drive into a step stops).
+    /// A stall on the wheels at `now`: in the autonomous mode with a climb configured and the
+    /// legs in the fold the climb starts from, the climb starts (`true`); otherwise the caller
+    /// faults (a manual drive into a step stops). From the riding pose
+    /// ([`crate::legs::levelling::FoldFamily::ride_front`]) the climb's first move put the
+    /// front feet down behind their hips, and no robot of 50 climbed a 6 cm step: a riser
+    /// met riding is one the rangefinder missed, and the robot stops.
     #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
     pub(super) fn climb_on_stall(&mut self, now: Tick) -> bool {
-        if self.config.climb.is_none() {
+        if self.config.climb.is_none() || self.auto.riding.clear() {
             return false;
         }
         self.apply(Event::StepStall);
@@ -27,7 +53,7 @@ impl Controller {
         }
         let measured =
             PerLeg::from_fn(|leg| LegJoints::from_array(*self.sensors.joint_position_rad.leg(leg)));
-        self.climb = Some(Climb::new(now, &self.config.geometry, &measured));
+        self.auto.climb = Some(Climb::new(now, &self.config.geometry, &measured));
         true
     }
 
@@ -35,21 +61,28 @@ impl Controller {
     /// clear whatever the wheels are asked next (a STOP there does not swing them); off the
     /// wheels the climb is over.
     pub(super) fn climb_flags_into(&mut self, next: State) {
-        self.on_top &= matches!(
+        self.auto.riding.enter(next);
+        self.auto.on_top &= matches!(
             next,
             State::Wheels(_) | State::Folding(_) | State::Climbing(_)
         );
     }
 
+    /// Whether the legs ride clear of a slope the rangefinder saw (else, on the wheels, in the
+    /// fold or with the front legs clear after a climb).
+    pub fn rides_clear(&self) -> bool {
+        self.auto.riding.clear()
+    }
+
     /// The climb under way, if any.
     pub fn climb(&self) -> Option<&Climb> {
-        self.climb.as_ref()
+        self.auto.climb.as_ref()
     }
 
     /// This tick of the climb: the legs' goal; at its end the fold.
     #[inline(never)] // As `climb_on_stall`.
     pub(super) fn climb_step(&mut self, now: Tick) {
-        let (Some(mut climb), Some(config)) = (self.climb, self.config.climb) else {
+        let (Some(mut climb), Some(config)) = (self.auto.climb, self.config.climb) else {
             self.apply(Event::PoseReached);
             return;
         };
@@ -73,10 +106,10 @@ impl Controller {
             climb.stop(now);
         }
         climb.tick(&config, self.config.rate, now, &input);
-        self.climb = Some(climb);
+        self.auto.climb = Some(climb);
         match climb.phase() {
             Phase::Ended(end) => {
-                self.climb = None;
+                self.auto.climb = None;
                 let refused = !matches!(end, ClimbEnd::Over | ClimbEnd::Stopped);
                 if refused {
                     // Given up: fold and balance (driving on would meet the same riser).
@@ -84,9 +117,9 @@ impl Controller {
                 }
                 self.apply(Event::PoseReached);
                 // After the transition, which clears both for a new fold.
-                self.climbed = end == ClimbEnd::Over;
-                self.on_top |= self.climbed;
-                self.step_refused = refused;
+                self.auto.climbed = end == ClimbEnd::Over;
+                self.auto.on_top |= self.auto.climbed;
+                self.auto.step_refused = refused;
             }
             _ => {
                 self.climb_pose(&climb);

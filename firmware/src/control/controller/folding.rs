@@ -135,12 +135,23 @@ impl Controller {
     }
 
     /// Which of the balance law's trim rules may learn now: from the position error only on
-    /// the wheels, the following of the balance point also in a fold whose legs are tucked.
-    pub(super) fn set_trim_rules(&mut self) {
+    /// the wheels, the following of the balance point also in a fold whose legs are tucked;
+    /// riding clear of a slope, the slope's rules ([`super::riding::Riding::trim_band_rad`]).
+    pub(super) fn set_trim_rules(&mut self, now: Tick) {
         let wheels = matches!(self.state, State::Wheels(_));
         let tucked = matches!(self.state, State::Folding(_)) && self.fold_done_at.is_some();
         self.balance.set_trim_learning(wheels);
         self.balance.set_trim_following(wheels || tucked);
+        let settled = self
+            .legs_rad
+            .iter()
+            .zip(&self.goal_rad)
+            .all(|(now, goal)| (goal - now).abs() <= self.config.pose_tolerance_rad);
+        let rate = self.config.rate;
+        let riding = &mut self.auto.riding;
+        self.balance
+            .set_trim_band(riding.trim_band_rad(rate, now, settled));
+        self.balance.set_forgiving(riding.forgive_s());
         let in_place = matches!(self.state, State::Wheels(WheelMotion::Balance));
         self.balance
             .set_place_holding(in_place && self.stopped_on_wheels);
@@ -251,36 +262,41 @@ impl Controller {
         self.within_limits(self.levelling.pose(&self.config.levelling))
     }
 
-    /// Where a fold tucks the legs, and where they ride on the wheels: the fold pose; after a
-    /// climb (or on top) with the front legs clear ([`Controller::with_front_clear`]): tucked
-    /// under the torso, they dragged on the plateau as the balance law caught the robot
-    /// tipping off its back feet, and the robot ran away.
+    /// Where a fold tucks the legs, and where they ride on the wheels: the fold pose; riding
+    /// clear of a slope, both pairs clear of the ground
+    /// ([`crate::legs::levelling::FoldFamily::ride_front`], `ride_back`); after a climb (or
+    /// on top) the front legs clear ([`crate::legs::levelling::FoldFamily::front_clear`]):
+    /// tucked under the torso, they dragged on the plateau as the balance law caught the
+    /// robot tipping off its back feet, and the robot ran away.
     #[inline(never)] // As `level`.
     pub(super) fn fold_goal_rad(&self) -> Joints<f32> {
         let fold_rad = self.fold_rad();
-        if self.climbed || self.on_top {
-            self.with_front_clear(fold_rad)
+        let family = &self.config.levelling.family;
+        if self.auto.riding.clear() {
+            let pose = self.with_pair(fold_rad, [Leg::Fl, Leg::Fr], family.ride_front);
+            self.with_pair(pose, [Leg::Bl, Leg::Br], family.ride_back)
+        } else if self.auto.climbed || self.auto.on_top {
+            self.with_pair(fold_rad, [Leg::Fl, Leg::Fr], family.front_clear)
         } else {
             fold_rad
         }
     }
 
-    /// `pose` with the front legs as the autonomous mode carries them: high, clear of a
-    /// plateau's edge the wheels roll off ([`crate::legs::levelling::FoldFamily::front_clear`]).
+    /// `pose` with the legs of `pair` at `left` (the right leg mirrors its abduction),
+    /// clamped into the joint ranges.
     #[inline(never)] // As `level`.
-    fn with_front_clear(&self, pose: Joints<f32>) -> Joints<f32> {
-        let left = self.config.levelling.family.front_clear;
+    fn with_pair(&self, pose: Joints<f32>, pair: [Leg; 2], left: LegJoints) -> Joints<f32> {
         let right = LegJoints {
             hip_abduction_rad: -left.hip_abduction_rad,
             ..left
         };
-        let clear = self.within_limits(Joints::from_leg_fn(|leg| match leg {
+        let set = self.within_limits(Joints::from_leg_fn(|leg| match leg {
             Leg::Fr | Leg::Br => right.to_array(),
             Leg::Fl | Leg::Bl => left.to_array(),
         }));
         let mut pose = pose;
-        for leg in [Leg::Fl, Leg::Fr] {
-            *pose.leg_mut(leg) = *clear.leg(leg);
+        for leg in pair {
+            *pose.leg_mut(leg) = *set.leg(leg);
         }
         pose
     }

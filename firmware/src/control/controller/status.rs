@@ -26,7 +26,7 @@ impl Controller {
         if self.leg_blocked {
             faults = faults.with(FaultFlags::LEG_BLOCKED);
         }
-        if self.step_refused {
+        if self.auto.step_refused {
             faults = faults.with(FaultFlags::STEP_REFUSED);
         }
         if self.teleop.interlocked() {

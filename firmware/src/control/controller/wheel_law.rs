@@ -14,6 +14,19 @@ use crate::wheels::wheel::mix;
 /// hard off a plateau tripped the stall watch 1.3 s later and began to climb at the edge).
 const LANDING_NO_CLIMB_MS: u32 = 2_000;
 
+/// Share of the speed reference a robot whose stall watch has tripped still rolls at, in the
+/// reference's direction, for the mode riding clear of a slope to roll on instead of stopping:
+/// a riser stops the wheels within the collision's few ticks; the foot of a slope the robot
+/// runs down only slows it (the wheels meet the flat at the lean that held it on the slope,
+/// and it kept 60 % of its speed).
+const ROLLING_ON_SHARE: f32 = 0.5;
+
+/// Whether a tripped stall watch's robot still rolls on (see [`ROLLING_ON_SHARE`]).
+fn rolling_on(input: &RunawayInput) -> bool {
+    let wanted = input.velocity_ref_m_s;
+    input.ground_speed_m_s * wanted.signum() > ROLLING_ON_SHARE * wanted.abs()
+}
+
 impl Controller {
     /// This tick's wheel torques `[left, right]` from the balance law and the turn loop (none
     /// while the attitude is unknown).
@@ -21,7 +34,7 @@ impl Controller {
         if !self.sensors.attitude_known(now) {
             return [0.0; 2];
         }
-        self.set_trim_rules();
+        self.set_trim_rules(now);
         let (velocity_ref_m_s, turn_ref_rad_s) = self.wheel_references(now);
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
         let common = self.balance.update(
@@ -43,14 +56,17 @@ impl Controller {
                 torque_nm: common,
                 torque_limit_nm: self.config.balance.torque_limit_nm,
             };
-            if let Some(cause) = self.runaway.update(&self.config.runaway, &input) {
+            self.runaway.set_patient(self.auto.riding.clear());
+            let tripped = self.runaway.update(&self.config.runaway, &input);
+            let stall = tripped == Some(protocol::FaultFlags::WHEEL_STALL);
+            // Riding clear of a slope, the slope's foot slows the robot without stopping it.
+            let rolls_on = stall && self.auto.riding.clear() && rolling_on(&input);
+            if let Some(cause) = tripped.filter(|_| !rolls_on) {
                 // A stall just after a drop is the landing, not a riser: stop, do not climb.
                 let landed = self
                     .traction
                     .fell_within(self.config.rate.ticks_from_ms(LANDING_NO_CLIMB_MS));
-                let climbs = cause == protocol::FaultFlags::WHEEL_STALL
-                    && !landed
-                    && self.climb_on_stall(now);
+                let climbs = stall && !landed && self.climb_on_stall(now);
                 if !climbs {
                     self.wheel_fault_stop(now, cause, input.ground_speed_m_s);
                 }
@@ -100,6 +116,8 @@ impl Controller {
         let yaw_rad_s = self.teleop.yaw_rate_rad_s;
         match self.state {
             State::Wheels(WheelMotion::Drive(Direction::Forward)) => (preset_m_s, turn(yaw_rad_s)),
+            // A change of the riding pose is made standing.
+            State::Wheels(WheelMotion::Auto) if self.auto.riding.reposing() => (0.0, 0.0),
             State::Wheels(WheelMotion::Drive(Direction::Backward) | WheelMotion::Auto) => {
                 (-preset_m_s, turn(yaw_rad_s))
             }

@@ -12,6 +12,7 @@ use sim_host::robot::imu::{ImuModel, ImuNoise};
 use sim_host::robot::imu_chip::ChipSpec;
 use sim_host::robot::model::{DEFAULT_MODEL, OBSTACLES_MODEL};
 use sim_host::robot::plant::{DriveRatings, Plant};
+use sim_host::robot::rangefinder::{RangeModel, RangeSpec};
 use sim_host::robot::sensing::DriveSensing;
 use sim_host::robot::variation::Variation;
 use sim_host::scene::{Scene, SceneError};
@@ -37,6 +38,15 @@ pub(crate) enum ImuArg {
     /// delay.
     Chip,
     /// A perfect chip: the true rate and specific force (for debugging).
+    Ideal,
+}
+
+/// What the emulated rangefinder measures with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub(crate) enum RangeArg {
+    /// An ST VL53L1X: 1.3 m, 20 ms rangings over its field of view, offset and noise, 1 mm.
+    Part,
+    /// The centre ray's exact length (for debugging).
     Ideal,
 }
 
@@ -157,6 +167,12 @@ pub(crate) struct RunArgs {
     /// delay) or `ideal` (the true rate and specific force, for debugging).
     #[arg(long, value_enum, default_value_t = ImuArg::Chip)]
     pub(crate) imu: ImuArg,
+    /// What the rangefinder measures with: `part` (an ST VL53L1X in its short distance mode:
+    /// 1.3 m, a ranging every 20 ms over its field of view, ±20 mm typical error, whole
+    /// millimetres; its offset drawn with `--seed`) or `ideal` (the exact distance, for
+    /// debugging).
+    #[arg(long, value_enum, default_value_t = RangeArg::Part)]
+    pub(crate) rangefinder: RangeArg,
     /// What the drives can deliver: `rated` (a quasi-direct-drive leg actuator, 33.5 N·m peak
     /// with its torque-speed line and thermal foldback; 30 N·m hub motors) or `ideal` (the
     /// report's unlimited leg servos, flat 30 N·m wheels, for debugging).
@@ -371,6 +387,13 @@ fn session_config(
                 accel_std_m_s2: args.accel_noise_m_s2,
                 seed: args.seed,
                 ..ImuNoise::default()
+            },
+            rangefinder: match args.rangefinder {
+                RangeArg::Part => RangeModel::Part {
+                    spec: RangeSpec::VL53L1X,
+                    seed: args.seed,
+                },
+                RangeArg::Ideal => RangeModel::Ideal,
             },
             drives: match args.drives {
                 DrivesArg::Rated => DriveRatings::RATED,

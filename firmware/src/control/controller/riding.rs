@@ -1,0 +1,219 @@
+//! How the autonomous mode carries its legs on the wheels, chosen by the ground the
+//! rangefinder sees behind ([`crate::control::terrain`]): in the fold, which the climb of a
+//! step starts from, or clear of a slope
+//! ([`crate::legs::levelling::FoldFamily::ride_front`], `ride_back`).
+//!
+//! Backing up a 10° ramp the robot leans 12° beyond its balance point, and the fold's back
+//! shanks, 0.45 m behind the axle, met the slope 0.6 s after the wheels; coming down, the
+//! front shanks met it. Riding clear they do not, but the climb of a step does not start from
+//! there (its first move put the front feet down behind their hips; no robot of 50 climbed).
+//! So the pose follows what lies behind: a slope up seen there sets the legs clear, a riser
+//! seen from level ground sets them back in the fold. Each change is made standing: the robot
+//! brakes, the legs move once it rolls slower than [`REPOSE_SLOW_M_S`], and it drives on once
+//! they are there and it has stood still. Moving the legs' mass rolls the robot back 0.1–0.2 m
+//! (0.5 m on the heaviest-legged robots), inside the 0.6 m or more the rangefinder sees ahead
+//! of the wheels.
+//!
+//! Riding clear, the stall watch waits longer for a robot standing still against its
+//! reference ([`crate::wheels::runaway::Runaway::set_patient`]: one starting up a slope leans
+//! into it for a second or more first), a stall that leaves the robot rolling is the foot of a
+//! slope, not a riser (`wheel_law`), and the balance law keeps its trim within a band and
+//! forgives a position error it is making up ([`Riding::trim_band_rad`],
+//! [`Riding::forgive_s`]).
+
+use super::Controller;
+use crate::control::fsm::{State, WheelMotion};
+use crate::control::terrain::{Feature, Ranging, TerrainWatch};
+use crate::time::{Tick, TickRate};
+
+/// The robot is still for a change of pose below this ground speed, m/s, …
+const REPOSE_STILL_M_S: f32 = 0.03;
+
+/// … for this long, ms.
+const REPOSE_STILL_MS: u32 = 300;
+
+/// The longest a change of pose holds the robot, ms.
+const REPOSE_MAX_MS: u32 = 3_000;
+
+/// How far from the learned trim the balance point may move for the trim to follow it riding
+/// clear, rad: a 10° slope leans the robot 12° beyond it, while legs that swing in at the
+/// fold's rate move it less than this at a time (see
+/// [`crate::wheels::balance::Balance::set_trim_band`]).
+const TRIM_BAND_RAD: f32 = 4.0 * core::f32::consts::PI / 180.0;
+
+/// How long the legs must have ridden still before the trim band applies, ms: the trim must
+/// first find the balance point the riding legs give (a heavy-legged robot's moved 9°).
+const TRIM_SETTLE_MS: u32 = 1_500;
+
+/// How fast a position error the robot is making up is forgiven riding clear, s (see
+/// [`crate::wheels::balance::Balance::set_forgiving`]).
+const FORGIVE_S: f32 = 0.2;
+
+/// The watch reads the ground only while the body pitches slower than this, rad/s, …
+const STEADY_RAD_S: f32 = 0.3;
+
+/// … and this long after a drop has ended, ms.
+const LANDED_MS: u32 = 1_000;
+
+/// A change of pose waits for the robot to roll slower than this before the legs move, m/s:
+/// moving them while it brakes from its speed pitched a heavy-legged robot 19° and rolled it
+/// 0.56 m.
+const REPOSE_SLOW_M_S: f32 = 0.1;
+
+/// A change of pose under way.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Repose {
+    /// When it began.
+    since: Tick,
+    /// The pose it changes to (clear or not), set once the robot has slowed.
+    to_clear: bool,
+    /// Since when the robot has stood still with its legs there (`None`: not yet).
+    still_since: Option<Tick>,
+}
+
+/// The autonomous mode's riding pose and what decides it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(super) struct Riding {
+    /// Whether the legs ride clear of a slope (else in the fold).
+    clear: bool,
+    repose: Option<Repose>,
+    watch: TerrainWatch,
+    /// How far the robot has backed in the mode, m (the watch's path).
+    backed_m: f32,
+    /// Since when the legs have ridden still and clear (`None`: they move, or ride folded).
+    settled_since: Option<Tick>,
+}
+
+impl Riding {
+    /// Whether the legs ride clear of a slope.
+    pub(super) fn clear(&self) -> bool {
+        self.clear
+    }
+
+    /// Whether a change of pose holds the robot.
+    pub(super) fn reposing(&self) -> bool {
+        self.repose.is_some()
+    }
+
+    /// What a transition into `next` keeps: the pose while the robot stays on its wheels (a
+    /// STOP on a ramp does not swing the legs into it), the watch and a change of pose only
+    /// in the autonomous mode.
+    pub(super) fn enter(&mut self, next: State) {
+        if !matches!(next, State::Wheels(_)) {
+            self.clear = false;
+        }
+        if next != State::Wheels(WheelMotion::Auto) {
+            self.repose = None;
+            self.watch.reset();
+        }
+    }
+
+    /// The band the trim follows the balance point within (`None`: any): riding clear, once
+    /// the legs have settled for [`TRIM_SETTLE_MS`] (`settled`: at their goal now).
+    pub(super) fn trim_band_rad(
+        &mut self,
+        rate: TickRate,
+        now: Tick,
+        settled: bool,
+    ) -> Option<f32> {
+        self.settled_since = if self.clear && settled {
+            self.settled_since.or(Some(now))
+        } else {
+            None
+        };
+        let since = self.settled_since?;
+        (now.since(since) >= rate.ticks_from_ms(TRIM_SETTLE_MS)).then_some(TRIM_BAND_RAD)
+    }
+
+    /// How fast a position error being made up is forgiven, s (`None`: it is made up): riding
+    /// clear, but not while the legs move there (the robot holds its place meanwhile: the
+    /// riding legs' mass moves back, and a heavy-legged robot rolled 0.7 m to the foot of the
+    /// slope without it).
+    pub(super) fn forgive_s(&self) -> Option<f32> {
+        (self.clear && self.repose.is_none()).then_some(FORGIVE_S)
+    }
+}
+
+impl Controller {
+    /// This tick of the autonomous mode's watch on the ground behind (every tick: the
+    /// ranging received is consumed in every state): a slope or a step decided starts a change
+    /// of pose if the legs ride the other way; a change under way ends once the legs are
+    /// there and the robot has stood still for [`REPOSE_STILL_MS`], or after
+    /// [`REPOSE_MAX_MS`].
+    #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
+    pub(super) fn ride_step(&mut self, now: Tick, dt_s: f32) {
+        let ranging = self.sensors.take_range();
+        if self.state != State::Wheels(WheelMotion::Auto) {
+            return;
+        }
+        let speed_m_s = self.ground_speed_m_s();
+        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        // Pitching fast (a drop's landing, a start), the estimated pitch lags the body's by
+        // more than the watch's heights allow: it learns anew once the body is steady.
+        let steady = pitch_rate_rad_s.abs() < STEADY_RAD_S
+            && !self
+                .traction
+                .fell_within(self.config.rate.ticks_from_ms(LANDED_MS));
+        let riding = &mut self.auto.riding;
+        riding.backed_m -= speed_m_s * dt_s;
+        if !steady {
+            riding.watch.reset();
+        } else if let Some(distance_m) = ranging {
+            let ranging = Ranging {
+                distance_m,
+                pitch_rad: self.sensors.attitude.pitch_rad,
+                backed_m: riding.backed_m,
+            };
+            // Back into the fold only on level ground: on a slope the robot leans off its trim,
+            // and stopping there to fold meets the slope with the fold's shanks.
+            let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
+            let level = lean_rad.abs() < TRIM_BAND_RAD;
+            // Up only: down a slope the legs already ride clear (the robot came up one), and
+            // off an edge the spot jumps along the beam by a run that the body's pitch can make
+            // look like a slope's; an edge needs no fold (the legs ride clear of it).
+            let clear = match riding.watch.update(&self.config.terrain, &ranging) {
+                Some(Feature::Slope { rise_m }) if rise_m > 0.0 => Some(true),
+                Some(Feature::Step { rise_m }) if rise_m > 0.0 && level => Some(false),
+                _ => None,
+            };
+            let changing = riding.repose.map_or(riding.clear, |r| r.to_clear);
+            if let Some(to_clear) = clear.filter(|&clear| clear != changing) {
+                riding.repose = Some(Repose {
+                    since: now,
+                    to_clear,
+                    still_since: None,
+                });
+                self.runaway.reset();
+            }
+        }
+        let Some(mut repose) = self.auto.riding.repose else {
+            return;
+        };
+        if self.auto.riding.clear != repose.to_clear && speed_m_s.abs() < REPOSE_SLOW_M_S {
+            self.auto.riding.clear = repose.to_clear;
+        }
+        let moved = self.auto.riding.clear == repose.to_clear;
+        let tolerance_rad = self.config.pose_tolerance_rad;
+        let there = self
+            .legs_rad
+            .iter()
+            .zip(&self.goal_rad)
+            .all(|(now, goal)| (goal - now).abs() <= tolerance_rad);
+        repose.still_since = if moved && there && speed_m_s.abs() < REPOSE_STILL_M_S {
+            repose.still_since.or(Some(now))
+        } else {
+            None
+        };
+        let rate = self.config.rate;
+        let stood = repose
+            .still_since
+            .is_some_and(|at| now.since(at) >= rate.ticks_from_ms(REPOSE_STILL_MS));
+        if stood || now.since(repose.since) >= rate.ticks_from_ms(REPOSE_MAX_MS) {
+            self.auto.riding.clear = repose.to_clear;
+            self.auto.riding.repose = None;
+            self.runaway.reset();
+        } else {
+            self.auto.riding.repose = Some(repose);
+        }
+    }
+}

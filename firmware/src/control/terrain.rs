@@ -1,0 +1,258 @@
+//! The ground behind the robot, as the rangefinder sees it: level, a step (a riser or an edge)
+//! or a slope, told apart before the wheels reach it.
+//!
+//! The rangefinder on the torso's rear face looks back and down. Each ranging, with the
+//! estimated pitch, gives the height of the ground where the beam meets it, over the wheels'
+//! contact, and where that is along the path (the distance the robot has backed plus how far
+//! behind the axle the beam lands). A step and a slope both raise (or lower) that height; they
+//! differ in how far the beam's spot travels along the path while the height changes: at a
+//! riser the spot climbs its face and stays where it is, off an edge it jumps along the beam to
+//! the lower ground, on a slope it moves on with the rise at the slope's grade. So the watch
+//! notes where the spot last read the level ground, follows a height that leaves it by
+//! [`TerrainConfig::onset_m`], and decides once it has left it by [`TerrainConfig::decide_m`]:
+//! a slope if the height changed from the level at a grade well under the beam's
+//! ([`TerrainConfig::steep_share`]), a step otherwise.
+//!
+//! Heights are taken against a level learned from the ground behind while it is level, not
+//! against zero: an estimated pitch 1° off puts the spot 1.4 cm high or low at 0.8 m, and the
+//! accelerometer's offset leaves the estimate that far off on some robots. After each
+//! decision, and after a ranging without a return, the level is learned anew (the robot is
+//! about to change what it stands on; the ground left the beam's range), from rangings that
+//! agree for a tenth of a second.
+
+/// Where the rangefinder sits and how the watch reads it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TerrainConfig {
+    /// The rangefinder's position relative to the wheel axle in the torso's frame, m: x
+    /// forward, z up.
+    pub mount_x_m: f32,
+    /// … and up.
+    pub mount_z_m: f32,
+    /// How far below the torso's x axis the beam points, rad.
+    pub depression_rad: f32,
+    /// Wheel radius, m: the wheels' contact lies this far below the axle.
+    pub wheel_radius_m: f32,
+    /// A height this far from the level starts a feature, m.
+    pub onset_m: f32,
+    /// … and this far decides it, m.
+    pub decide_m: f32,
+    /// Heights within this of the level end a feature that went no further, and agree with
+    /// each other for a new level, m.
+    pub level_band_m: f32,
+    /// Heights within this of the level keep learning it, m: narrower than the band, so that
+    /// the foot of a slope is not learned as level (a 10° slope rises 5 mm in 3 cm).
+    pub learn_band_m: f32,
+    /// A feature is a slope when the height changed between the last level ranging and the
+    /// decision by less than this share of what the beam's own grade gives over the spot's
+    /// run in between: at a
+    /// riser's face the spot stands still while the height changes; off an edge the spot jumps
+    /// along the beam, from the edge to the lower ground, its height changing at the beam's
+    /// grade (tan 25° and more); a 10° slope changes at its own, tan 10°.
+    pub steep_share: f32,
+    /// How much of each new level height the learned level takes, per ranging.
+    pub level_gain: f32,
+    /// How far along the path past a decision the spot must move before a level is learned
+    /// again, m: the rest of a riser's face (the spot stands still on it) is no level.
+    pub quiet_m: f32,
+    /// How far along the path an onset may run without a decision, m, before the height it
+    /// has stayed at becomes the level (a 5° slope decides within 0.3 m).
+    pub onset_run_m: f32,
+}
+
+impl TerrainConfig {
+    /// The robot's VL53L1X on the rear face of the torso, 0.30 m behind and 0.09 m above the
+    /// axle, 25° down (the beam meets level ground 0.7–0.9 m behind the axle on the wheels). A
+    /// 10° slope rises 2.5 cm while the spot moves 14 cm; a riser's face rises with the spot
+    /// standing still.
+    pub const ROBOT: Self = Self {
+        mount_x_m: -0.30,
+        mount_z_m: 0.09,
+        depression_rad: 25.0 * core::f32::consts::PI / 180.0,
+        wheel_radius_m: 0.12,
+        onset_m: 0.015,
+        decide_m: 0.04,
+        level_band_m: 0.01,
+        learn_band_m: 0.005,
+        steep_share: 0.7,
+        level_gain: 0.05,
+        quiet_m: 0.05,
+        onset_run_m: 0.35,
+    };
+}
+
+/// What lies behind the robot.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Feature {
+    /// A riser (`rise_m` > 0) or an edge (< 0), `rise_m` being the height decided on.
+    Step {
+        /// How far the ground rose at the decision, m.
+        rise_m: f32,
+    },
+    /// A slope, up (`rise_m` > 0) or down.
+    Slope {
+        /// How far the ground rose at the decision, m.
+        rise_m: f32,
+    },
+}
+
+/// One ranging, with what the watch needs to place it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ranging {
+    /// The distance along the beam, m (`None`: no return within the part's range).
+    pub distance_m: Option<f32>,
+    /// The torso's estimated pitch, rad (+ nose down).
+    pub pitch_rad: f32,
+    /// How far the robot has backed so far, m (any origin; + backward).
+    pub backed_m: f32,
+}
+
+/// The watch.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct TerrainWatch {
+    /// The level ground's height as the beam reads it, m (`None`: not learned yet).
+    level_m: Option<f32>,
+    /// Which way the height has left the level (+1 up, −1 down; `None`: it has not).
+    onset: Option<f32>,
+    /// Where along the path the spot last read the level, and how far the robot had backed
+    /// then, m.
+    level_along_m: f32,
+    level_backed_m: f32,
+    /// Rangings in a row back within the level band during a feature.
+    back_level: u8,
+    /// After a decision: where along the path the spot must be for the watch to learn again.
+    quiet_until_m: Option<f32>,
+    /// A level being learned: the first height and how many rangings in a row have agreed
+    /// with it.
+    candidate: Option<(f32, u8)>,
+}
+
+/// Rangings in a row back at the level that end a feature's onset (a pitch wobble).
+const BACK_LEVEL_RANGINGS: u8 = 3;
+
+/// Rangings in a row within the level band of each other that make a new level (0.1 s): after
+/// a climb the robot pitches as it settles onto its wheels, and one ranging then saw the ground
+/// beyond the plateau's far edge instead of the plateau.
+const LEVEL_RANGINGS: u8 = 5;
+
+impl TerrainWatch {
+    /// Forgets the level and any onset: the next ranging starts a new level.
+    pub fn reset(&mut self) {
+        *self = Self::default();
+    }
+
+    /// The ground's height over the wheels' contact where the beam meets it, m, and how far
+    /// behind the axle that is, m.
+    pub fn spot_m(config: &TerrainConfig, distance_m: f32, pitch_rad: f32) -> (f32, f32) {
+        let (sin_d, cos_d) = crate::math::sin_cos(config.depression_rad);
+        // The spot in the torso's frame, relative to the axle: x forward, z up.
+        let x = config.mount_x_m - distance_m * cos_d;
+        let z = config.mount_z_m - distance_m * sin_d;
+        // Rotated into the level frame by the pitch (+ nose down: the front goes down).
+        let (sin_p, cos_p) = crate::math::sin_cos(pitch_rad);
+        let level_x = x * cos_p + z * sin_p;
+        let level_z = -x * sin_p + z * cos_p;
+        (level_z + config.wheel_radius_m, -level_x)
+    }
+
+    /// Takes one ranging; returns the feature it decides, if any.
+    pub fn update(&mut self, config: &TerrainConfig, ranging: &Ranging) -> Option<Feature> {
+        let Some(distance_m) = ranging.distance_m else {
+            // The ground left the part's range (down a slope the beam runs flat): what the
+            // spot meets next may be anywhere, and a jump there is no riser.
+            self.reset();
+            return None;
+        };
+        let (height_m, behind_m) = Self::spot_m(config, distance_m, ranging.pitch_rad);
+        if !height_m.is_finite() || !behind_m.is_finite() {
+            return None;
+        }
+        let along_m = ranging.backed_m + behind_m;
+        if let Some(until_m) = self.quiet_until_m {
+            if along_m < until_m {
+                return None;
+            }
+            self.quiet_until_m = None;
+        }
+        let Some(level_m) = self.level_m else {
+            self.candidate = match self.candidate {
+                Some((first_m, n)) if (height_m - first_m).abs() <= config.level_band_m => {
+                    if n.saturating_add(1) >= LEVEL_RANGINGS {
+                        self.level_m = Some(first_m);
+                        self.level_along_m = along_m;
+                        self.level_backed_m = ranging.backed_m;
+                        None
+                    } else {
+                        Some((first_m, n.saturating_add(1)))
+                    }
+                }
+                _ => Some((height_m, 1)),
+            };
+            return None;
+        };
+        let rise_m = height_m - level_m;
+        let run_m = (along_m - self.level_along_m).abs();
+        let Some(sign) = self.onset else {
+            if rise_m.abs() <= config.learn_band_m {
+                self.level_m = Some(level_m + config.level_gain * rise_m);
+                self.level_along_m = along_m;
+                self.level_backed_m = ranging.backed_m;
+            }
+            if rise_m.abs() >= config.onset_m {
+                self.onset = Some(rise_m.signum());
+                self.back_level = 0;
+            }
+            if rise_m.abs() < config.decide_m {
+                return None;
+            }
+            return self.decide(config, ranging, rise_m, run_m, along_m);
+        };
+        if rise_m * sign >= config.decide_m {
+            return self.decide(config, ranging, rise_m, run_m, along_m);
+        }
+        if run_m > config.onset_run_m {
+            // No slope rises this little this far: the ground is level at its new height.
+            self.level_m = Some(height_m);
+            self.level_along_m = along_m;
+            self.level_backed_m = ranging.backed_m;
+            self.onset = None;
+        } else if rise_m.abs() <= config.level_band_m {
+            self.back_level = self.back_level.saturating_add(1);
+            if self.back_level >= BACK_LEVEL_RANGINGS {
+                self.onset = None;
+                self.level_along_m = along_m;
+                self.level_backed_m = ranging.backed_m;
+            }
+        } else {
+            self.back_level = 0;
+        }
+        None
+    }
+
+    /// The feature a height `rise_m` off the level decides, the spot `run_m` along the path
+    /// from where it last read the level; the watch then learns anew.
+    fn decide(
+        &mut self,
+        config: &TerrainConfig,
+        ranging: &Ranging,
+        rise_m: f32,
+        run_m: f32,
+        along_m: f32,
+    ) -> Option<Feature> {
+        // The spot runs up a slope because the robot backs along it; a body that pitches
+        // sweeps it up onto an edge standing still.
+        let backed_m = (ranging.backed_m - self.level_backed_m).abs();
+        let swept = rise_m > 0.0 && backed_m < 0.5 * run_m;
+        self.reset();
+        self.quiet_until_m = Some(along_m + config.quiet_m);
+        let (sin, cos) = crate::math::sin_cos(config.depression_rad + ranging.pitch_rad);
+        let slope = rise_m.abs() < config.steep_share * run_m * sin / cos && !swept;
+        Some(if slope {
+            Feature::Slope { rise_m }
+        } else {
+            Feature::Step { rise_m }
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests;
