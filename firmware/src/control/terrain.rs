@@ -113,10 +113,8 @@ pub struct TerrainWatch {
     level_m: Option<f32>,
     /// Which way the height has left the level (+1 up, −1 down; `None`: it has not).
     onset: Option<f32>,
-    /// Where along the path the spot last read the level, and how far the robot had backed
-    /// then, m.
-    level_along_m: f32,
-    level_backed_m: f32,
+    /// The last ranging that read the level (within [`TerrainConfig::level_band_m`]).
+    mark: Mark,
     /// Rangings in a row back within the level band during a feature.
     back_level: u8,
     /// After a decision: where along the path the spot must be for the watch to learn again.
@@ -124,6 +122,15 @@ pub struct TerrainWatch {
     /// A level being learned: the first height and how many rangings in a row have agreed
     /// with it.
     candidate: Option<(f32, u8)>,
+}
+
+/// Where a ranging's spot was, m: along the path, how far the robot had backed, and how far
+/// the height stood off the level.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+struct Mark {
+    along_m: f32,
+    backed_m: f32,
+    rise_m: f32,
 }
 
 /// Rangings in a row back at the level that end a feature's onset (a pitch wobble).
@@ -178,8 +185,11 @@ impl TerrainWatch {
                 Some((first_m, n)) if (height_m - first_m).abs() <= config.level_band_m => {
                     if n.saturating_add(1) >= LEVEL_RANGINGS {
                         self.level_m = Some(first_m);
-                        self.level_along_m = along_m;
-                        self.level_backed_m = ranging.backed_m;
+                        self.mark = Mark {
+                            along_m,
+                            backed_m: ranging.backed_m,
+                            rise_m: height_m - first_m,
+                        };
                         None
                     } else {
                         Some((first_m, n.saturating_add(1)))
@@ -190,12 +200,17 @@ impl TerrainWatch {
             return None;
         };
         let rise_m = height_m - level_m;
-        let run_m = (along_m - self.level_along_m).abs();
+        let here = Mark {
+            along_m,
+            backed_m: ranging.backed_m,
+            rise_m,
+        };
         let Some(sign) = self.onset else {
             if rise_m.abs() <= config.learn_band_m {
                 self.level_m = Some(level_m + config.level_gain * rise_m);
-                self.level_along_m = along_m;
-                self.level_backed_m = ranging.backed_m;
+            }
+            if rise_m.abs() <= config.level_band_m {
+                self.mark = here;
             }
             if rise_m.abs() >= config.onset_m {
                 self.onset = Some(rise_m.signum());
@@ -204,23 +219,24 @@ impl TerrainWatch {
             if rise_m.abs() < config.decide_m {
                 return None;
             }
-            return self.decide(config, ranging, rise_m, run_m, along_m);
+            return self.decide(config, ranging.pitch_rad, here);
         };
         if rise_m * sign >= config.decide_m {
-            return self.decide(config, ranging, rise_m, run_m, along_m);
+            return self.decide(config, ranging.pitch_rad, here);
         }
-        if run_m > config.onset_run_m {
+        if (along_m - self.mark.along_m).abs() > config.onset_run_m {
             // No slope rises this little this far: the ground is level at its new height.
             self.level_m = Some(height_m);
-            self.level_along_m = along_m;
-            self.level_backed_m = ranging.backed_m;
+            self.mark = Mark {
+                rise_m: 0.0,
+                ..here
+            };
             self.onset = None;
         } else if rise_m.abs() <= config.level_band_m {
             self.back_level = self.back_level.saturating_add(1);
             if self.back_level >= BACK_LEVEL_RANGINGS {
                 self.onset = None;
-                self.level_along_m = along_m;
-                self.level_backed_m = ranging.backed_m;
+                self.mark = here;
             }
         } else {
             self.back_level = 0;
@@ -228,24 +244,21 @@ impl TerrainWatch {
         None
     }
 
-    /// The feature a height `rise_m` off the level decides, the spot `run_m` along the path
-    /// from where it last read the level; the watch then learns anew.
-    fn decide(
-        &mut self,
-        config: &TerrainConfig,
-        ranging: &Ranging,
-        rise_m: f32,
-        run_m: f32,
-        along_m: f32,
-    ) -> Option<Feature> {
+    /// The feature the ranging `here` decides (pitched `pitch_rad`), from the grade between
+    /// the last level ranging and it; the watch then learns anew.
+    fn decide(&mut self, config: &TerrainConfig, pitch_rad: f32, here: Mark) -> Option<Feature> {
+        let mark = self.mark;
+        let run_m = (here.along_m - mark.along_m).abs();
         // The spot runs up a slope because the robot backs along it; a body that pitches
         // sweeps it up onto an edge standing still.
-        let backed_m = (ranging.backed_m - self.level_backed_m).abs();
-        let swept = rise_m > 0.0 && backed_m < 0.5 * run_m;
+        let backed_m = (here.backed_m - mark.backed_m).abs();
+        let swept = here.rise_m > 0.0 && backed_m < 0.5 * run_m;
         self.reset();
-        self.quiet_until_m = Some(along_m + config.quiet_m);
-        let (sin, cos) = crate::math::sin_cos(config.depression_rad + ranging.pitch_rad);
-        let slope = rise_m.abs() < config.steep_share * run_m * sin / cos && !swept;
+        self.quiet_until_m = Some(here.along_m + config.quiet_m);
+        let (sin, cos) = crate::math::sin_cos(config.depression_rad + pitch_rad);
+        let change_m = (here.rise_m - mark.rise_m).abs();
+        let slope = change_m < config.steep_share * run_m * sin / cos && !swept;
+        let rise_m = here.rise_m;
         Some(if slope {
             Feature::Slope { rise_m }
         } else {
