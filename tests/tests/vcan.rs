@@ -75,3 +75,34 @@ fn all_30_mode_pairs_over_vcan_keep_the_robot_up_and_in_limits() {
     assert_eq!(summary["missed_cycles"].as_u64(), Some(0), "{summary}");
     println!("30 mode pairs over vcan: no fall, no limit violation");
 }
+
+/// The obstacle course in the autonomous mode, the firmware its own process on kernel vcan:
+/// the step climbed and left behind, the ramp rolled over, within the 60 s.
+#[test]
+fn the_course_over_vcan_is_crossed_end_to_end_in_the_autonomous_mode() {
+    let bus = Vcan::new();
+    let fw = firmware(&bus);
+    let out = out_dir("course");
+    let course = hil_tests::workspace().join("scenarios/course.toml");
+    let course = course.to_string_lossy();
+    let summary = simulate(&bus, &out, &["--scenario", &course]).expect("summary");
+    let _ = fw.terminate();
+    let auto = &summary["segments"][1];
+    assert_eq!(auto["fell"].as_bool(), Some(false), "{auto}");
+    let crossings = auto["crossings"].as_array().expect("crossings");
+    let past_s = |name: &str| {
+        crossings
+            .iter()
+            .find(|c| c["obstacle"] == name)
+            .and_then(|c| c["past_s"].as_f64())
+            .unwrap_or_else(|| panic!("{name} not crossed: {auto}"))
+    };
+    let (step_s, ramp_s) = (past_s("step"), past_s("ramp_down"));
+    let climbs = auto["climbs_s"].as_array().expect("climbs_s");
+    println!(
+        "course over vcan: the step left behind {step_s:.1} s and the ramp {ramp_s:.1} s after the mode began, climbs {climbs:?}"
+    );
+    assert!(step_s < ramp_s && ramp_s <= 60.0, "{auto}");
+    assert_eq!(climbs.len(), 1, "{auto}");
+    assert_eq!(summary["missed_cycles"].as_u64(), Some(0), "{summary}");
+}

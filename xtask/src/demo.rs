@@ -6,6 +6,9 @@
 //! (Foxglove), the plots, a few rendered frames and their animation `run.gif` in `out/` and
 //! prints a table of the segments.
 //!
+//! `cargo xtask demo --course` runs `scenarios/course.toml` instead, into `out/course/`: the
+//! autonomous mode over the course (a step up and down, then the 10° ramp), behind the robot.
+//!
 //! `cargo xtask demo --teleop` instead opens teleop's terminal UI on the simulated robot: the
 //! simulator and the firmware run in the teleop process on the in-process bus, so anyone can
 //! drive the robot with the report's keys without a CAN interface. The run's telemetry, bus log
@@ -19,6 +22,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
     let mut scenario = root().join("scenarios").join("report_demo.toml");
     let mut render = true;
     let mut teleop = false;
+    let mut course = false;
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         let mut value = |name: &str| {
@@ -32,12 +36,17 @@ pub fn run(args: &[String]) -> Result<(), String> {
             "--scenario" => scenario = value("--scenario")?.into(),
             "--no-render" => render = false,
             "--teleop" => teleop = true,
+            "--course" => course = true,
             other => {
                 return Err(format!(
-                    "unknown option `{other}`: use --bus IFNAME, --out DIR, --scenario FILE, --no-render, --teleop"
+                    "unknown option `{other}`: use --bus IFNAME, --out DIR, --scenario FILE, --no-render, --teleop, --course"
                 ))
             }
         }
+    }
+    if course {
+        scenario = root().join("scenarios").join("course.toml");
+        out = out.join("course");
     }
     crate::setup::run()?;
     if teleop {

@@ -93,6 +93,8 @@ Tasks:
                      --out DIR     --scenario FILE     --no-render (skip the rendered frames)
                      --teleop      drive it yourself instead: teleop's terminal UI on the
                                    simulated robot (keys W S A L K X, T, F, space, Q)
+                     --course      the autonomous mode over the course (step, then 10° ramp)
+                                   instead: scenarios/course.toml into out/course/
 ";
 
 fn main() -> ExitCode {
