@@ -274,7 +274,10 @@ impl Controller {
             self.follow_measured();
         }
         let dt_s = self.config.rate.period_s();
-        self.ride_step(now, dt_s);
+        let ranging = self.sensors.take_range();
+        if self.state == State::Wheels(WheelMotion::Auto) {
+            self.ride_step(now, dt_s, ranging);
+        }
         let depth_m = self.config.posture.depth_for(self.teleop.body_height_m);
         let previous = self.legs_rad;
         let mut legs_enabled = self.armed;

@@ -142,11 +142,13 @@ impl Controller {
         let tucked = matches!(self.state, State::Folding(_)) && self.fold_done_at.is_some();
         self.balance.set_trim_learning(wheels);
         self.balance.set_trim_following(wheels || tucked);
-        let settled = self
-            .legs_rad
-            .iter()
-            .zip(&self.goal_rad)
-            .all(|(now, goal)| (goal - now).abs() <= self.config.pose_tolerance_rad);
+        // Only riding clear: the comparison of 16 joints is no work for every tick.
+        let settled = self.auto.riding.clear()
+            && self
+                .legs_rad
+                .iter()
+                .zip(&self.goal_rad)
+                .all(|(now, goal)| (goal - now).abs() <= self.config.pose_tolerance_rad);
         let rate = self.config.rate;
         let riding = &mut self.auto.riding;
         self.balance

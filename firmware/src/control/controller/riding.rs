@@ -135,57 +135,66 @@ impl Riding {
 }
 
 impl Controller {
-    /// This tick of the autonomous mode's watch on the ground behind (every tick: the
-    /// ranging received is consumed in every state): a slope or a step decided starts a change
-    /// of pose if the legs ride the other way; a change under way ends once the legs are
-    /// there and the robot has stood still for [`REPOSE_STILL_MS`], or after
-    /// [`REPOSE_MAX_MS`].
+    /// This tick of the autonomous mode's watch on the ground behind, with the ranging
+    /// received this tick (`None`: none; the caller consumes it in every state): a slope or a
+    /// step decided starts a change of pose if the legs ride the other way; a change under way
+    /// ends once the legs are there and the robot has stood still for [`REPOSE_STILL_MS`], or
+    /// after [`REPOSE_MAX_MS`].
     #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
-    pub(super) fn ride_step(&mut self, now: Tick, dt_s: f32) {
-        let ranging = self.sensors.take_range();
-        if self.state != State::Wheels(WheelMotion::Auto) {
-            return;
-        }
+    pub(super) fn ride_step(&mut self, now: Tick, dt_s: f32, ranging: Option<Option<f32>>) {
         let speed_m_s = self.ground_speed_m_s();
+        self.auto.riding.backed_m -= speed_m_s * dt_s;
+        if let Some(distance_m) = ranging {
+            self.watch_ranging(now, distance_m);
+        }
+        self.repose_step(now, speed_m_s);
+    }
+
+    /// Reads one ranging into the terrain watch, and starts a change of pose for what it
+    /// decides. Pitching fast (a drop's landing, a start), the estimated pitch lags the body's
+    /// by more than the watch's heights allow: it learns anew once the body is steady.
+    #[inline(never)] // Once in five ticks: its frame stays off the others.
+    fn watch_ranging(&mut self, now: Tick, distance_m: Option<f32>) {
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
-        // Pitching fast (a drop's landing, a start), the estimated pitch lags the body's by
-        // more than the watch's heights allow: it learns anew once the body is steady.
         let steady = pitch_rate_rad_s.abs() < STEADY_RAD_S
             && !self
                 .traction
                 .fell_within(self.config.rate.ticks_from_ms(LANDED_MS));
         let riding = &mut self.auto.riding;
-        riding.backed_m -= speed_m_s * dt_s;
         if !steady {
             riding.watch.reset();
-        } else if let Some(distance_m) = ranging {
-            let ranging = Ranging {
-                distance_m,
-                pitch_rad: self.sensors.attitude.pitch_rad,
-                backed_m: riding.backed_m,
-            };
-            // Back into the fold only on level ground: on a slope the robot leans off its trim,
-            // and stopping there to fold meets the slope with the fold's shanks.
-            let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
-            let level = lean_rad.abs() < TRIM_BAND_RAD;
-            // Up only: down a slope the legs already ride clear (the robot came up one), and
-            // off an edge the spot jumps along the beam by a run that the body's pitch can make
-            // look like a slope's; an edge needs no fold (the legs ride clear of it).
-            let clear = match riding.watch.update(&self.config.terrain, &ranging) {
-                Some(Feature::Slope { rise_m }) if rise_m > 0.0 => Some(true),
-                Some(Feature::Step { rise_m }) if rise_m > 0.0 && level => Some(false),
-                _ => None,
-            };
-            let changing = riding.repose.map_or(riding.clear, |r| r.to_clear);
-            if let Some(to_clear) = clear.filter(|&clear| clear != changing) {
-                riding.repose = Some(Repose {
-                    since: now,
-                    to_clear,
-                    still_since: None,
-                });
-                self.runaway.reset();
-            }
+            return;
         }
+        let ranging = Ranging {
+            distance_m,
+            pitch_rad: self.sensors.attitude.pitch_rad,
+            backed_m: riding.backed_m,
+        };
+        // Back into the fold only on level ground: on a slope the robot leans off its trim,
+        // and stopping there to fold meets the slope with the fold's shanks.
+        let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
+        let level = lean_rad.abs() < TRIM_BAND_RAD;
+        // Up only: down a slope the legs already ride clear (the robot came up one), and off
+        // an edge the spot jumps along the beam by a run that the body's pitch can make look
+        // like a slope's; an edge needs no fold (the legs ride clear of it).
+        let clear = match riding.watch.update(&self.config.terrain, &ranging) {
+            Some(Feature::Slope { rise_m }) if rise_m > 0.0 => Some(true),
+            Some(Feature::Step { rise_m }) if rise_m > 0.0 && level => Some(false),
+            _ => None,
+        };
+        let changing = riding.repose.map_or(riding.clear, |r| r.to_clear);
+        if let Some(to_clear) = clear.filter(|&clear| clear != changing) {
+            riding.repose = Some(Repose {
+                since: now,
+                to_clear,
+                still_since: None,
+            });
+            self.runaway.reset();
+        }
+    }
+
+    /// This tick of a change of pose, the robot rolling at `speed_m_s`.
+    fn repose_step(&mut self, now: Tick, speed_m_s: f32) {
         let Some(mut repose) = self.auto.riding.repose else {
             return;
         };
