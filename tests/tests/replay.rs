@@ -238,6 +238,7 @@ fn consumers(frame: &Frame) -> (u64, u64) {
             | MessageId::LegFeedback(_)
             | MessageId::WheelFeedback
             | MessageId::Imu
+            | MessageId::Range
             | MessageId::TeleopCommand
             | MessageId::TeleopHeartbeat
             | MessageId::DriveStatus(_),
