@@ -5,12 +5,12 @@
 
 use rand::rngs::SmallRng;
 use rand::SeedableRng;
-use rand_distr::{Distribution, Normal};
 
 use protocol::{Acceleration, AngularRate, AnyMessage, EncodeError, Frame, Imu, Key, MessageId};
 
 use crate::robot::imu_chip::{ChipSpec, ImuChip};
 use crate::robot::link::NodeLink;
+use crate::robot::noise::gaussian;
 use crate::robot::physics::Physics;
 
 /// What sits between the simulated truth and the wire.
@@ -89,11 +89,7 @@ impl ImuNode {
     }
 
     fn gaussian(&mut self, std: f64) -> f64 {
-        if std > 0.0 {
-            Normal::new(0.0, std).map_or(0.0, |n| n.sample(&mut self.rng))
-        } else {
-            0.0
-        }
+        gaussian(&mut self.rng, std)
     }
 
     /// The sample the node sends at `now_us`: the chip's newest output for the current state.

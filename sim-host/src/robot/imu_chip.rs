@@ -31,9 +31,9 @@
 //!
 //! Everything is drawn from one generator seeded per run, so a run repeats exactly.
 
+use crate::robot::noise::gaussian;
 use rand::rngs::SmallRng;
 use rand::SeedableRng;
-use rand_distr::{Distribution, Normal};
 
 const DEG: f64 = std::f64::consts::PI / 180.0;
 /// Standard gravity, m/s² (the data sheet's g).
@@ -210,14 +210,6 @@ impl Channel {
     fn quantised(&self, value: [f64; 3]) -> [f64; 3] {
         let (lsb, full) = (self.spec.lsb, self.spec.full_scale);
         value.map(|v| ((v.clamp(-full, full) / lsb).round() * lsb).clamp(-full, full))
-    }
-}
-
-fn gaussian(rng: &mut SmallRng, std: f64) -> f64 {
-    if std > 0.0 {
-        Normal::new(0.0, std).map_or(0.0, |n| n.sample(rng))
-    } else {
-        0.0
     }
 }
 

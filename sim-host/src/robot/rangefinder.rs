@@ -21,11 +21,11 @@
 
 use rand::rngs::SmallRng;
 use rand::SeedableRng;
-use rand_distr::{Distribution, Normal};
 
 use protocol::{AnyMessage, EncodeError, Frame, Key, MessageId, Range, RangeDistance, RangeStatus};
 
 use crate::robot::link::NodeLink;
+use crate::robot::noise::gaussian;
 use crate::robot::physics::Physics;
 
 /// The figures of a time-of-flight part.
@@ -161,13 +161,5 @@ impl RangeNode {
     /// Seals a ranging in the node's session (`None` before it has joined one).
     pub fn seal(&mut self, message: &AnyMessage) -> Result<Option<Frame>, EncodeError> {
         self.link.seal(message)
-    }
-}
-
-fn gaussian(rng: &mut SmallRng, std: f64) -> f64 {
-    if std > 0.0 {
-        Normal::new(0.0, std).map_or(0.0, |n| n.sample(rng))
-    } else {
-        0.0
     }
 }

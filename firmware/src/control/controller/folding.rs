@@ -143,12 +143,7 @@ impl Controller {
         self.balance.set_trim_learning(wheels);
         self.balance.set_trim_following(wheels || tucked);
         // Only riding clear: the comparison of 16 joints is no work for every tick.
-        let settled = self.auto.riding.clear()
-            && self
-                .legs_rad
-                .iter()
-                .zip(&self.goal_rad)
-                .all(|(now, goal)| (goal - now).abs() <= self.config.pose_tolerance_rad);
+        let settled = self.auto.riding.clear() && self.legs_at_goal();
         let rate = self.config.rate;
         let riding = &mut self.auto.riding;
         self.balance
@@ -203,16 +198,21 @@ impl Controller {
         self.stance().height_m >= support.wheel_contact_height_m - support.margin_m
     }
 
+    /// Whether every commanded joint is within the pose tolerance of its goal.
+    pub(super) fn legs_at_goal(&self) -> bool {
+        let tolerance_rad = self.config.pose_tolerance_rad;
+        self.legs_rad
+            .iter()
+            .zip(&self.goal_rad)
+            .all(|(now, goal)| (goal - now).abs() <= tolerance_rad)
+    }
+
     /// Whether a running transition is over (checked after this tick's goal and move, so the
     /// next tick runs the new state).
     pub(super) fn transition_arrived(&self) -> bool {
         let arrived = match self.state {
             State::Folding(_) => self.transfer_done,
-            State::Standing(_) => self
-                .legs_rad
-                .iter()
-                .zip(&self.goal_rad)
-                .all(|(now, goal)| (goal - now).abs() <= self.config.pose_tolerance_rad),
+            State::Standing(_) => self.legs_at_goal(),
             _ => false,
         };
         arrived && self.armed

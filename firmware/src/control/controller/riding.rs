@@ -202,12 +202,7 @@ impl Controller {
             self.auto.riding.clear = repose.to_clear;
         }
         let moved = self.auto.riding.clear == repose.to_clear;
-        let tolerance_rad = self.config.pose_tolerance_rad;
-        let there = self
-            .legs_rad
-            .iter()
-            .zip(&self.goal_rad)
-            .all(|(now, goal)| (goal - now).abs() <= tolerance_rad);
+        let there = self.legs_at_goal();
         repose.still_since = if moved && there && speed_m_s.abs() < REPOSE_STILL_M_S {
             repose.still_since.or(Some(now))
         } else {
