@@ -55,6 +55,7 @@ fn all_events() -> Vec<Event> {
         Event::LegBlocked,
         Event::StepStall,
         Event::StepRefused,
+        Event::RangeLost,
         Event::PoseReached,
         Event::EStopLatch,
         Event::EStopClear,
@@ -201,6 +202,7 @@ fn every_request_in_every_state_has_a_defined_safe_result() {
                     | Event::LinkDegraded
                     | Event::LegBlocked
                     | Event::StepRefused
+                    | Event::RangeLost
             ) {
                 let climbing = matches!(state, State::Climbing(_));
                 assert!(

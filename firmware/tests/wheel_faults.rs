@@ -11,7 +11,8 @@ use firmware::control::fsm::{State, WheelMotion};
 use firmware::control::safety::SS1_DEADLINE_MS;
 use firmware::{Config, Controller, Tick};
 use protocol::{
-    AnyMessage, ControllerMode, EStop, FaultFlags, NodeId, TeleopHeartbeat, TeleopMode,
+    AnyMessage, ControllerMode, EStop, FaultFlags, NodeId, Range, RangeDistance, RangeStatus,
+    TeleopHeartbeat, TeleopMode,
 };
 
 const CONFIG: Config = Config::ROBOT;
@@ -32,6 +33,8 @@ struct Bench {
     now: u32,
     joints_rad: protocol::Joints<f32>,
     wheels: Wheels,
+    /// What the rangefinder ranges every 20 ms, m (`None`: it is silent).
+    ranging_m: Option<f32>,
 }
 
 impl Bench {
@@ -42,6 +45,7 @@ impl Bench {
             now: 0,
             joints_rad: common::standing_joints_rad(&CONFIG),
             wheels: Wheels::Follow,
+            ranging_m: None,
         };
         bench.run(5);
         bench.send(command(TeleopMode::Stop));
@@ -70,6 +74,12 @@ impl Ticks for Bench {
         };
         for message in plant_feedback_rolling(&self.joints_rad, rate_rad_s) {
             self.send(message);
+        }
+        if let Some(distance_m) = self.ranging_m.filter(|_| self.now % 5 == 0) {
+            self.send(AnyMessage::Range(Range {
+                distance: RangeDistance::saturating_from_si(distance_m),
+                status: RangeStatus::Valid,
+            }));
         }
         if self.now % 5 == 0 {
             self.send(AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
@@ -198,4 +208,47 @@ fn following_wheels_never_trip_in_drive_stop_turn_and_reverse() {
             assert_ne!(output.status.mode, ControllerMode::Fault, "{mode:?}");
         }
     }
+}
+
+#[test]
+fn the_autonomous_mode_stops_and_says_so_when_the_rangefinder_falls_silent() {
+    let mut bench = Bench::on_the_wheels();
+    bench.ranging_m = Some(0.8);
+    bench.send(command(TeleopMode::Auto));
+    for _ in 0..ms(2_000) {
+        let output = bench.tick();
+        assert!(!output.status.faults.contains(FaultFlags::RANGE_TIMEOUT));
+    }
+    assert_eq!(bench.state(), State::Wheels(WheelMotion::Auto));
+    // Silent: stopped within ten of the part's 20 ms rangings, balancing, the flag up.
+    bench.ranging_m = None;
+    let mut stopped_after = None;
+    for n in 1..=ms(300) {
+        let output = bench.tick();
+        if bench.state() != State::Wheels(WheelMotion::Auto) {
+            assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+            assert!(output.status.faults.contains(FaultFlags::RANGE_TIMEOUT));
+            stopped_after = Some(n);
+            break;
+        }
+    }
+    let stopped_after = stopped_after.expect("still driving blind after 0.3 s");
+    assert!(
+        stopped_after >= ms(180),
+        "stopped after {stopped_after} ticks"
+    );
+    for _ in 0..ms(500) {
+        let output = bench.tick();
+        assert!(output.status.faults.contains(FaultFlags::RANGE_TIMEOUT));
+        assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+    }
+    // The operator's next request (a key other than the one held) clears the report, and
+    // with the part ranging again the mode drives on.
+    bench.ranging_m = Some(0.8);
+    bench.send(command(TeleopMode::Stop));
+    let output = bench.tick();
+    assert!(!output.status.faults.contains(FaultFlags::RANGE_TIMEOUT));
+    bench.send(command(TeleopMode::Auto));
+    bench.run(ms(500));
+    assert_eq!(bench.state(), State::Wheels(WheelMotion::Auto));
 }

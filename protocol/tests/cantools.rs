@@ -133,6 +133,7 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
                 "runaway",
                 "leg_blocked",
                 "step_refused",
+                "range_timeout",
             ];
             for (bit, flag) in flags.iter().enumerate() {
                 put(

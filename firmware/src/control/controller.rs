@@ -380,6 +380,7 @@ impl Controller {
             // The operator has seen the stop and asks for something: the report has served.
             self.leg_blocked = false;
             self.auto.step_refused = false;
+            self.auto.range_lost = false;
         }
         let next = self.state.next(event);
         if next == self.state {

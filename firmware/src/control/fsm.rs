@@ -6,12 +6,12 @@
 //!
 //! # Transition table
 //!
-//! `Request(·)` is an operator request (teleop frame); `TeleopLost`, `LinkDegraded` and
-//! `LegBlocked` are stop requests the controller makes itself. `Legs(m)` and `Wheels(m)` are the
+//! `Request(·)` is an operator request (teleop frame); `TeleopLost`, `LinkDegraded`,
+//! `LegBlocked`, `StepRefused` and `RangeLost` are stop requests the controller makes itself. `Legs(m)` and `Wheels(m)` are the
 //! steady states, `Standing(m)` / `Folding(m)` the transitions that end in them on `PoseReached`.
 //! `—` means the event leaves the state unchanged.
 //!
-//! | state ↓ / event →  | Stop (X), `TeleopLost`, `LinkDegraded`, `LegBlocked`, `StepRefused` | Stand          | Trot d (L/K/Walk) | Fold             | Wheel w (W/S/A/Drive/H) | `PoseReached` |
+//! | state ↓ / event →  | Stop (X), `TeleopLost`, `LinkDegraded`, `LegBlocked`, `StepRefused`, `RangeLost` | Stand          | Trot d (L/K/Walk) | Fold             | Wheel w (W/S/A/Drive/H) | `PoseReached` |
 //! |--------------------|----------------------------------------------------|----------------|-------------------|------------------|-------------------|---------------|
 //! | `Hold`             | —                                                    | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | —             |
 //! | `Legs(_)`          | Legs(Stand)                                          | Legs(Stand)    | Legs(Trot d)      | Folding(Balance) | Folding(w)        | —             |
@@ -137,6 +137,9 @@ pub enum Event {
     /// The running climb gave up (a step out of its range, or no ground within reach):
     /// treated as a stop request.
     StepRefused,
+    /// The autonomous mode heard no ranging for too long (it would drive blind): treated as
+    /// a stop request.
+    RangeLost,
     /// The legs arrived at the pose of the running transition.
     PoseReached,
     /// An E-stop frame asked to latch.
@@ -172,7 +175,8 @@ impl State {
                 | Event::TeleopLost
                 | Event::LinkDegraded
                 | Event::LegBlocked
-                | Event::StepRefused,
+                | Event::StepRefused
+                | Event::RangeLost,
             ) => State::Climbing(WheelMotion::Balance),
             (State::Climbing(_), _) => self,
             (State::Wheels(WheelMotion::Auto), Event::StepStall) => {
@@ -182,7 +186,11 @@ impl State {
             (_, Event::PoseReached) => self,
             (
                 _,
-                Event::TeleopLost | Event::LinkDegraded | Event::LegBlocked | Event::StepRefused,
+                Event::TeleopLost
+                | Event::LinkDegraded
+                | Event::LegBlocked
+                | Event::StepRefused
+                | Event::RangeLost,
             ) => self.on_request(TeleopMode::Stop),
             (_, Event::Request(mode)) => self.on_request(mode),
         }

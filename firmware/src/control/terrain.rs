@@ -44,11 +44,16 @@ pub struct TerrainConfig {
     pub learn_band_m: f32,
     /// A feature is a slope when the height changed between the last level ranging and the
     /// decision by less than this share of what the beam's own grade gives over the spot's
-    /// run in between: at a
-    /// riser's face the spot stands still while the height changes; off an edge the spot jumps
-    /// along the beam, from the edge to the lower ground, its height changing at the beam's
-    /// grade (tan 25° and more); a 10° slope changes at its own, tan 10°.
+    /// run in between: at a riser's face the spot stands still while the height changes; off
+    /// an edge the spot jumps along the beam, from the edge to the lower ground, its height
+    /// changing at the beam's grade, tan(25° − pitch); a 10° slope changes at its own,
+    /// tan 10°. A robot leaning 10° nose down brings the two within 0.66 of each other.
     pub steep_share: f32,
+    /// The beam must meet level ground at least this steeply for a decision, rad: below it a
+    /// 10° slope's grade comes within [`Self::steep_share`] of the beam's own, and the two
+    /// cannot be told apart (a robot leaning 14° nose down looks back 11° down, and read a
+    /// ramp there as a riser); the watch then decides nothing.
+    pub min_beam_rad: f32,
     /// How much of each new level height the learned level takes, per ranging.
     pub level_gain: f32,
     /// How far along the path past a decision the spot must move before a level is learned
@@ -73,7 +78,8 @@ impl TerrainConfig {
         decide_m: 0.04,
         level_band_m: 0.01,
         learn_band_m: 0.005,
-        steep_share: 0.7,
+        steep_share: 0.85,
+        min_beam_rad: 13.0 * core::f32::consts::PI / 180.0,
         level_gain: 0.05,
         quiet_m: 0.05,
         onset_run_m: 0.35,
@@ -111,8 +117,9 @@ pub struct Ranging {
 pub struct TerrainWatch {
     /// The level ground's height as the beam reads it, m (`None`: not learned yet).
     level_m: Option<f32>,
-    /// Which way the height has left the level (+1 up, −1 down; `None`: it has not).
-    onset: Option<f32>,
+    /// Whether the height has left the level by [`TerrainConfig::onset_m`] (either way: a
+    /// feature decides on how far it went, whichever way it went on).
+    onset: bool,
     /// The last ranging that read the level (within [`TerrainConfig::level_band_m`]).
     mark: Mark,
     /// Rangings in a row back within the level band during a feature.
@@ -145,6 +152,15 @@ impl TerrainWatch {
     /// Forgets the level and any onset: the next ranging starts a new level.
     pub fn reset(&mut self) {
         *self = Self::default();
+    }
+
+    /// Forgets the level and any onset, as [`Self::reset`], but keeps the quiet stretch of a
+    /// decision: a body that pitched fast on a riser's face is still before that face.
+    pub fn unsteady(&mut self) {
+        *self = Self {
+            quiet_until_m: self.quiet_until_m,
+            ..Self::default()
+        };
     }
 
     /// The ground's height over the wheels' contact where the beam meets it, m, and how far
@@ -205,7 +221,7 @@ impl TerrainWatch {
             backed_m: ranging.backed_m,
             rise_m,
         };
-        let Some(sign) = self.onset else {
+        if !self.onset {
             if rise_m.abs() <= config.learn_band_m {
                 self.level_m = Some(level_m + config.level_gain * rise_m);
             }
@@ -213,29 +229,24 @@ impl TerrainWatch {
                 self.mark = here;
             }
             if rise_m.abs() >= config.onset_m {
-                self.onset = Some(rise_m.signum());
+                self.onset = true;
                 self.back_level = 0;
             }
-            if rise_m.abs() < config.decide_m {
-                return None;
-            }
-            return self.decide(config, ranging.pitch_rad, here);
-        };
-        if rise_m * sign >= config.decide_m {
+        }
+        if rise_m.abs() >= config.decide_m {
             return self.decide(config, ranging.pitch_rad, here);
         }
+        if !self.onset {
+            return None;
+        }
         if (along_m - self.mark.along_m).abs() > config.onset_run_m {
-            // No slope rises this little this far: the ground is level at its new height.
-            self.level_m = Some(height_m);
-            self.mark = Mark {
-                rise_m: 0.0,
-                ..here
-            };
-            self.onset = None;
+            // No slope rises this little this far: the ground is level at a new height, learned
+            // as at the start, from rangings that agree.
+            self.unsteady();
         } else if rise_m.abs() <= config.level_band_m {
             self.back_level = self.back_level.saturating_add(1);
             if self.back_level >= BACK_LEVEL_RANGINGS {
-                self.onset = None;
+                self.onset = false;
                 self.mark = here;
             }
         } else {
@@ -255,7 +266,13 @@ impl TerrainWatch {
         let swept = here.rise_m > 0.0 && backed_m < 0.5 * run_m;
         self.reset();
         self.quiet_until_m = Some(here.along_m + config.quiet_m);
-        let (sin, cos) = crate::math::sin_cos(config.depression_rad + pitch_rad);
+        // The beam meets level ground at its depression less the pitch (nose down lifts the
+        // rear face's beam toward the horizontal).
+        let beam_rad = config.depression_rad - pitch_rad;
+        if beam_rad < config.min_beam_rad {
+            return None;
+        }
+        let (sin, cos) = crate::math::sin_cos(beam_rad);
         let change_m = (here.rise_m - mark.rise_m).abs();
         let slope = change_m < config.steep_share * run_m * sin / cos && !swept;
         let rise_m = here.rise_m;

@@ -119,10 +119,13 @@ impl RangeNode {
         let RangeModel::Part { spec, .. } = self.model else {
             return;
         };
-        let mut rays = physics.range_rays_m();
+        // A ray that met nothing (MuJoCo's −1) is the farthest, not the nearest.
+        let mut rays = physics
+            .range_rays_m()
+            .map(|ray_m| if ray_m < 0.0 { f64::INFINITY } else { ray_m });
         rays.sort_by(f64::total_cmp);
         let median = rays[rays.len() / 2];
-        if median < 0.0 || median > spec.max_range_m {
+        if median > spec.max_range_m {
             self.missed += 1;
         } else {
             self.sum_m += median;

@@ -31,6 +31,9 @@ pub(super) struct Autonomy {
     /// Whether the autonomous mode gave up a climb: reported until the operator's next
     /// request.
     pub(super) step_refused: bool,
+    /// Whether the autonomous mode stopped for a silent rangefinder: reported until the
+    /// operator's next request.
+    pub(super) range_lost: bool,
     /// The legs' pose for the ground behind (see [`Riding`]).
     pub(super) riding: Riding,
 }

@@ -143,12 +143,13 @@ impl Controller {
         self.balance.set_trim_learning(wheels);
         self.balance.set_trim_following(wheels || tucked);
         // Only riding clear: the comparison of 16 joints is no work for every tick.
-        let settled = self.auto.riding.clear() && self.legs_at_goal();
+        let rules = self.slope_rules();
+        let settled = rules && self.legs_at_goal();
         let rate = self.config.rate;
         let riding = &mut self.auto.riding;
         self.balance
-            .set_trim_band(riding.trim_band_rad(rate, now, settled));
-        self.balance.set_forgiving(riding.forgive_s());
+            .set_trim_band(riding.trim_band_rad(rate, now, rules, settled));
+        self.balance.set_forgiving(riding.forgive_s(rules));
         let in_place = matches!(self.state, State::Wheels(WheelMotion::Balance));
         self.balance
             .set_place_holding(in_place && self.stopped_on_wheels);

@@ -14,7 +14,7 @@
 //! (0.5 m on the heaviest-legged robots), inside the 0.6 m or more the rangefinder sees ahead
 //! of the wheels.
 //!
-//! Riding clear, the stall watch waits longer for a robot standing still against its
+//! Riding clear in the autonomous mode ([`Controller::slope_rules`]), the stall watch waits longer for a robot standing still against its
 //! reference ([`crate::wheels::runaway::Runaway::set_patient`]: one starting up a slope leans
 //! into it for a second or more first), a stall that leaves the robot rolling is the foot of a
 //! slope, not a riser (`wheel_law`), and the balance law keeps its trim within a band and
@@ -22,7 +22,7 @@
 //! [`Riding::forgive_s`]).
 
 use super::Controller;
-use crate::control::fsm::{State, WheelMotion};
+use crate::control::fsm::{Event, State, WheelMotion};
 use crate::control::terrain::{Feature, Ranging, TerrainWatch};
 use crate::time::{Tick, TickRate};
 
@@ -60,6 +60,10 @@ const LANDED_MS: u32 = 1_000;
 /// 0.56 m.
 const REPOSE_SLOW_M_S: f32 = 0.1;
 
+/// The autonomous mode stops once no ranging has arrived for this long, ms: ten of the part's
+/// 50 Hz rangings (a lossy bus drops one now and then; a silent part drops them all).
+const RANGE_TIMEOUT_MS: u32 = 200;
+
 /// A change of pose under way.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Repose {
@@ -82,6 +86,8 @@ pub(super) struct Riding {
     backed_m: f32,
     /// Since when the legs have ridden still and clear (`None`: they move, or ride folded).
     settled_since: Option<Tick>,
+    /// Ticks in the mode since the last ranging.
+    silent_ticks: u32,
 }
 
 impl Riding {
@@ -99,6 +105,7 @@ impl Riding {
     /// STOP on a ramp does not swing the legs into it), the watch and a change of pose only
     /// in the autonomous mode.
     pub(super) fn enter(&mut self, next: State) {
+        self.silent_ticks = 0;
         if !matches!(next, State::Wheels(_)) {
             self.clear = false;
         }
@@ -108,15 +115,17 @@ impl Riding {
         }
     }
 
-    /// The band the trim follows the balance point within (`None`: any): riding clear, once
-    /// the legs have settled for [`TRIM_SETTLE_MS`] (`settled`: at their goal now).
+    /// The band the trim follows the balance point within (`None`: any): riding clear in the
+    /// autonomous mode (`rules`: [`Controller::slope_rules`]), once the legs have settled for
+    /// [`TRIM_SETTLE_MS`] (`settled`: at their goal now).
     pub(super) fn trim_band_rad(
         &mut self,
         rate: TickRate,
         now: Tick,
+        rules: bool,
         settled: bool,
     ) -> Option<f32> {
-        self.settled_since = if self.clear && settled {
+        self.settled_since = if rules && settled {
             self.settled_since.or(Some(now))
         } else {
             None
@@ -126,26 +135,42 @@ impl Riding {
     }
 
     /// How fast a position error being made up is forgiven, s (`None`: it is made up): riding
-    /// clear, but not while the legs move there (the robot holds its place meanwhile: the
-    /// riding legs' mass moves back, and a heavy-legged robot rolled 0.7 m to the foot of the
-    /// slope without it).
-    pub(super) fn forgive_s(&self) -> Option<f32> {
-        (self.clear && self.repose.is_none()).then_some(FORGIVE_S)
+    /// clear in the autonomous mode (`rules`), but not while the legs move there (the robot
+    /// holds its place meanwhile: the riding legs' mass moves back, and a heavy-legged robot
+    /// rolled 0.7 m to the foot of the slope without it).
+    pub(super) fn forgive_s(&self, rules: bool) -> Option<f32> {
+        (rules && self.repose.is_none()).then_some(FORGIVE_S)
     }
 }
 
 impl Controller {
+    /// Whether the slope's rules apply: riding clear in the autonomous mode. Legs left clear
+    /// under a manual drive keep their pose, but the robot is driven as anywhere else.
+    pub(super) fn slope_rules(&self) -> bool {
+        self.auto.riding.clear() && self.state == State::Wheels(WheelMotion::Auto)
+    }
+
     /// This tick of the autonomous mode's watch on the ground behind, with the ranging
     /// received this tick (`None`: none; the caller consumes it in every state): a slope or a
     /// step decided starts a change of pose if the legs ride the other way; a change under way
     /// ends once the legs are there and the robot has stood still for [`REPOSE_STILL_MS`], or
-    /// after [`REPOSE_MAX_MS`].
+    /// after [`REPOSE_MAX_MS`]. No ranging for [`RANGE_TIMEOUT_MS`] stops the mode
+    /// (`RANGE_TIMEOUT`).
     #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
     pub(super) fn ride_step(&mut self, now: Tick, dt_s: f32, ranging: Option<Option<f32>>) {
         let speed_m_s = self.ground_speed_m_s();
         self.auto.riding.backed_m -= speed_m_s * dt_s;
         if let Some(distance_m) = ranging {
+            self.auto.riding.silent_ticks = 0;
             self.watch_ranging(now, distance_m);
+        } else {
+            let silent = self.auto.riding.silent_ticks.saturating_add(1);
+            self.auto.riding.silent_ticks = silent;
+            if silent >= self.config.rate.ticks_from_ms(RANGE_TIMEOUT_MS) {
+                self.apply(Event::RangeLost);
+                self.auto.range_lost = true;
+                return;
+            }
         }
         self.repose_step(now, speed_m_s);
     }
@@ -161,8 +186,10 @@ impl Controller {
                 .traction
                 .fell_within(self.config.rate.ticks_from_ms(LANDED_MS));
         let riding = &mut self.auto.riding;
-        if !steady {
-            riding.watch.reset();
+        // The legs that move in a change of pose pitch the body as they go: what the beam
+        // sees meanwhile is no ground's.
+        if !steady || riding.repose.is_some() {
+            riding.watch.unsteady();
             return;
         }
         let ranging = Ranging {
@@ -193,13 +220,24 @@ impl Controller {
         }
     }
 
-    /// This tick of a change of pose, the robot rolling at `speed_m_s`.
+    /// This tick of a change of pose, the robot rolling at `speed_m_s`: the legs move once it
+    /// has slowed; a robot that has not slowed within [`REPOSE_MAX_MS`] (held on a slope, say)
+    /// keeps its pose and drives on, its stall watch still over it; legs that moved but did
+    /// not settle are let go after [`REPOSE_MAX_MS`] from their move.
     fn repose_step(&mut self, now: Tick, speed_m_s: f32) {
         let Some(mut repose) = self.auto.riding.repose else {
             return;
         };
-        if self.auto.riding.clear != repose.to_clear && speed_m_s.abs() < REPOSE_SLOW_M_S {
-            self.auto.riding.clear = repose.to_clear;
+        let rate = self.config.rate;
+        let max_ticks = rate.ticks_from_ms(REPOSE_MAX_MS);
+        if self.auto.riding.clear != repose.to_clear {
+            if speed_m_s.abs() < REPOSE_SLOW_M_S {
+                self.auto.riding.clear = repose.to_clear;
+                repose.since = now;
+            } else if now.since(repose.since) >= max_ticks {
+                self.auto.riding.repose = None;
+                return;
+            }
         }
         let moved = self.auto.riding.clear == repose.to_clear;
         let there = self.legs_at_goal();
@@ -208,12 +246,10 @@ impl Controller {
         } else {
             None
         };
-        let rate = self.config.rate;
         let stood = repose
             .still_since
             .is_some_and(|at| now.since(at) >= rate.ticks_from_ms(REPOSE_STILL_MS));
-        if stood || now.since(repose.since) >= rate.ticks_from_ms(REPOSE_MAX_MS) {
-            self.auto.riding.clear = repose.to_clear;
+        if stood || (moved && now.since(repose.since) >= max_ticks) {
             self.auto.riding.repose = None;
             self.runaway.reset();
         } else {

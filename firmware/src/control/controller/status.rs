@@ -29,6 +29,9 @@ impl Controller {
         if self.auto.step_refused {
             faults = faults.with(FaultFlags::STEP_REFUSED);
         }
+        if self.auto.range_lost {
+            faults = faults.with(FaultFlags::RANGE_TIMEOUT);
+        }
         if self.teleop.interlocked() {
             faults = faults.with(FaultFlags::AWAITING_STOP);
         }

@@ -24,7 +24,7 @@ const ROLLING_ON_SHARE: f32 = 0.5;
 /// Whether a tripped stall watch's robot still rolls on (see [`ROLLING_ON_SHARE`]).
 fn rolling_on(input: &RunawayInput) -> bool {
     let wanted = input.velocity_ref_m_s;
-    input.ground_speed_m_s * wanted.signum() > ROLLING_ON_SHARE * wanted.abs()
+    wanted != 0.0 && input.ground_speed_m_s * wanted.signum() > ROLLING_ON_SHARE * wanted.abs()
 }
 
 impl Controller {
@@ -56,11 +56,12 @@ impl Controller {
                 torque_nm: common,
                 torque_limit_nm: self.config.balance.torque_limit_nm,
             };
-            self.runaway.set_patient(self.auto.riding.clear());
+            let slope_rules = self.slope_rules();
+            self.runaway.set_patient(slope_rules);
             let tripped = self.runaway.update(&self.config.runaway, &input);
             let stall = tripped == Some(protocol::FaultFlags::WHEEL_STALL);
             // Riding clear of a slope, the slope's foot slows the robot without stopping it.
-            let rolls_on = stall && self.auto.riding.clear() && rolling_on(&input);
+            let rolls_on = stall && slope_rules && rolling_on(&input);
             if let Some(cause) = tripped.filter(|_| !rolls_on) {
                 // A stall just after a drop is the landing, not a riser: stop, do not climb.
                 let landed = self

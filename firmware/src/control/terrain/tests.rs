@@ -67,12 +67,25 @@ fn distance_m(ground: Ground, backed_m: f32, pitch_rad: f32) -> Option<f32> {
     })
 }
 
-/// Backs the robot over `ground` at 0.4 m/s for `run_m`, rangings every 20 ms, the true pitch
-/// wobbling by `wobble_rad` at 1.5 Hz and read `pitch_error_rad` off, the distance `noise_m`
-/// off in a fixed pattern; the features the watch decides, with where the robot was.
+/// [`back_over_leaning`] with the robot's balance point level.
 fn back_over(
     ground: Ground,
     run_m: f32,
+    wobble_rad: f32,
+    pitch_error_rad: f32,
+    noise_m: f32,
+) -> Vec<(f32, Feature)> {
+    back_over_leaning(ground, run_m, 0.0, wobble_rad, pitch_error_rad, noise_m)
+}
+
+/// Backs the robot over `ground` at 0.4 m/s for `run_m`, rangings every 20 ms, the true pitch
+/// `lean_rad` and wobbling by `wobble_rad` at 1.5 Hz about it, read `pitch_error_rad` off, the
+/// distance `noise_m` off in a fixed pattern; the features the watch decides, with where the
+/// robot was.
+fn back_over_leaning(
+    ground: Ground,
+    run_m: f32,
+    lean_rad: f32,
     wobble_rad: f32,
     pitch_error_rad: f32,
     noise_m: f32,
@@ -83,7 +96,8 @@ fn back_over(
     for k in 0..steps {
         let t_s = k as f32 * 0.02;
         let backed_m = 0.4 * t_s;
-        let pitch_rad = wobble_rad * crate::math::sin(2.0 * core::f32::consts::PI * 1.5 * t_s);
+        let pitch_rad =
+            lean_rad + wobble_rad * crate::math::sin(2.0 * core::f32::consts::PI * 1.5 * t_s);
         let sign = if k % 3 == 0 { -1.0 } else { 0.5 };
         // The part averages its returns over the ranging's 20 ms: five cycles.
         let cycles: Vec<f32> = (0..5)
@@ -195,16 +209,23 @@ fn a_ten_degree_ramp_is_a_slope_seen_before_the_wheels_reach_it() {
 }
 
 #[test]
-fn no_return_and_nonsense_decide_nothing() {
+fn nonsense_changes_nothing_and_no_return_forgets_the_level() {
     let mut watch = TerrainWatch::default();
-    for distance_m in [Some(f32::NAN), Some(f32::INFINITY), None] {
-        let ranging = Ranging {
-            distance_m,
-            pitch_rad: 0.0,
-            backed_m: 0.0,
-        };
-        assert_eq!(watch.update(&CONFIG, &ranging), None);
+    let ranging = |distance_m| Ranging {
+        distance_m,
+        pitch_rad: 0.0,
+        backed_m: 0.0,
+    };
+    for _ in 0..10 {
+        assert_eq!(watch.update(&CONFIG, &ranging(Some(0.5))), None);
     }
+    let learned = watch;
+    assert_ne!(learned, TerrainWatch::default(), "no level learned");
+    for distance_m in [f32::NAN, f32::INFINITY, f32::NEG_INFINITY] {
+        assert_eq!(watch.update(&CONFIG, &ranging(Some(distance_m))), None);
+        assert_eq!(watch, learned, "{distance_m} changed the watch");
+    }
+    assert_eq!(watch.update(&CONFIG, &ranging(None)), None);
     assert_eq!(watch, TerrainWatch::default());
 }
 
@@ -228,4 +249,44 @@ fn the_ground_back_in_range_after_no_return_is_a_new_level() {
         let backed_m = 0.11 + 0.01 * k as f32;
         assert_eq!(watch.update(&CONFIG, &ranging(Some(0.3), backed_m)), None);
     }
+}
+
+#[test]
+fn pitched_nose_down_or_up_an_edge_is_still_a_step_and_a_ramp_a_slope() {
+    // A robot whose balance point leans it 6° either way: the beam meets the ground 6° less
+    // (or more) steeply, and so does the spot's jump off an edge.
+    for pitch_rad in [10.0 * DEG, 6.0 * DEG, -6.0 * DEG, -10.0 * DEG] {
+        let edge = Ground::Riser {
+            at_m: 1.5,
+            height_m: -0.06,
+        };
+        let found = back_over_leaning(edge, 2.0, pitch_rad, 1.0 * DEG, 0.0, 0.005);
+        assert!(!found.is_empty(), "pitch {pitch_rad}: edge not seen");
+        assert!(
+            found
+                .iter()
+                .all(|(_, f)| matches!(f, Feature::Step { rise_m } if *rise_m < 0.0)),
+            "pitch {pitch_rad}: {found:?}"
+        );
+        let grade = crate::math::sin(10.0 * DEG) / crate::math::cos(10.0 * DEG);
+        let ramp = Ground::Slope { at_m: 1.5, grade };
+        let found = back_over_leaning(ramp, 1.4, pitch_rad, 1.0 * DEG, 0.0, 0.005);
+        assert!(!found.is_empty(), "pitch {pitch_rad}: ramp not seen");
+        assert!(
+            found
+                .iter()
+                .all(|(_, f)| matches!(f, Feature::Slope { rise_m } if *rise_m > 0.0)),
+            "pitch {pitch_rad}: {found:?}"
+        );
+    }
+}
+
+#[test]
+fn looking_back_too_shallow_to_tell_a_ramp_from_a_riser_decides_nothing() {
+    // Leaning 14° nose down, the beam meets the ground 11° down: a 10° ramp's grade is within
+    // a tenth of the beam's, as an edge's would be.
+    let grade = crate::math::sin(10.0 * DEG) / crate::math::cos(10.0 * DEG);
+    let ramp = Ground::Slope { at_m: 1.5, grade };
+    let found = back_over_leaning(ramp, 1.4, 14.0 * DEG, 0.5 * DEG, 0.0, 0.005);
+    assert!(found.is_empty(), "{found:?}");
 }
