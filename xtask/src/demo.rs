@@ -19,7 +19,7 @@ use crate::util::{cargo, root, run as sh};
 pub fn run(args: &[String]) -> Result<(), String> {
     let mut bus = "inproc".to_owned();
     let mut out = root().join("out");
-    let mut scenario = root().join("scenarios").join("report_demo.toml");
+    let mut scenario = None;
     let mut render = true;
     let mut teleop = false;
     let mut course = false;
@@ -33,7 +33,7 @@ pub fn run(args: &[String]) -> Result<(), String> {
         match arg.as_str() {
             "--bus" => bus = value("--bus")?,
             "--out" => out = value("--out")?.into(),
-            "--scenario" => scenario = value("--scenario")?.into(),
+            "--scenario" => scenario = Some(value("--scenario")?.into()),
             "--no-render" => render = false,
             "--teleop" => teleop = true,
             "--course" => course = true,
@@ -44,10 +44,20 @@ pub fn run(args: &[String]) -> Result<(), String> {
             }
         }
     }
-    if course {
-        scenario = root().join("scenarios").join("course.toml");
-        out = out.join("course");
-    }
+    let scenario: std::path::PathBuf = match (course, scenario) {
+        (true, Some(_)) => {
+            return Err(
+                "--course runs scenarios/course.toml: give --course or --scenario FILE, not both"
+                    .to_owned(),
+            )
+        }
+        (true, None) => {
+            out = out.join("course");
+            root().join("scenarios").join("course.toml")
+        }
+        (false, Some(file)) => file,
+        (false, None) => root().join("scenarios").join("report_demo.toml"),
+    };
     crate::setup::run()?;
     if teleop {
         if bus != "inproc" {

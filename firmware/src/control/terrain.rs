@@ -60,7 +60,8 @@ pub struct TerrainConfig {
     /// again, m: the rest of a riser's face (the spot stands still on it) is no level.
     pub quiet_m: f32,
     /// How far along the path an onset may run without a decision, m, before the height it
-    /// has stayed at becomes the level (a 5° slope decides within 0.3 m).
+    /// has stayed at becomes the level (a 10° slope decides 0.17 m past its last level
+    /// ranging; one under 5° may not decide, and is level ground at its new height).
     pub onset_run_m: f32,
 }
 

@@ -10,9 +10,9 @@
 //! So the pose follows what lies behind: a slope up seen there sets the legs clear, a riser
 //! seen from level ground sets them back in the fold. Each change is made standing: the robot
 //! brakes, the legs move once it rolls slower than [`REPOSE_SLOW_M_S`], and it drives on once
-//! they are there and it has stood still. Moving the legs' mass rolls the robot back 0.1–0.2 m
-//! (0.5 m on the heaviest-legged robots), inside the 0.6 m or more the rangefinder sees ahead
-//! of the wheels.
+//! they are there and it has stood still. The rangefinder decides a 10° ramp 0.3–0.7 m before
+//! the wheels reach its foot, and braking and moving the legs' mass roll the robot on
+//! 0.1–0.2 m (0.5 m on the heaviest-legged robots).
 //!
 //! Riding clear in the autonomous mode ([`Controller::slope_rules`]), the stall watch waits longer for a robot standing still against its
 //! reference ([`crate::wheels::runaway::Runaway::set_patient`]: one starting up a slope leans
