@@ -23,14 +23,14 @@ use teleop_core::scripted::{PlanStep, ScriptedTeleop};
 fn raw_step(c: &mut Criterion) {
     let mut physics = Physics::load(Path::new(DEFAULT_MODEL)).expect("model");
     let start = StartPose::standing();
-    physics.place(start.height_m, &start.leg_joint_rad);
+    physics.place(start.height_m, &start.leg_joint_rad, start.heading_rad);
     let mut steps = 0u32;
     c.bench_function("mujoco_step", |b| {
         b.iter(|| {
             // Restart now and then so that every sample measures a standing robot.
             steps += 1;
             if steps % 5_000 == 0 {
-                physics.place(start.height_m, &start.leg_joint_rad);
+                physics.place(start.height_m, &start.leg_joint_rad, start.heading_rad);
             }
             physics.step();
         })

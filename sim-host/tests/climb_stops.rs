@@ -17,6 +17,7 @@ const STEP: StepBehind = StepBehind {
     height_m: 0.06,
     distance_m: 1.2,
     plateau_m: LONG_PLATEAU_M,
+    heading_rad: 0.0,
 };
 /// How long after the stop the robot has to end balancing, s.
 const SETTLE_S: f64 = 20.0;

@@ -33,7 +33,7 @@ fn dropped_with_legs_extended_it_settles_standing_within_2_s() {
     let start = StartPose::standing();
     // Dropped from 3 cm above the ground, the leg drives' position loops holding the pose (the
     // model's leg actuators are torque motors).
-    p.place(start.height_m + 0.03, &start.leg_joint_rad);
+    p.place(start.height_m + 0.03, &start.leg_joint_rad, 0.0);
     let mut heights = Vec::new();
     for _ in 0..2 * STEPS_PER_S {
         let angles = p.leg_positions_rad();
@@ -81,7 +81,7 @@ fn folded_on_free_wheels_it_tips_over() {
     let fold = levelling.family.pose(levelling.start_shift);
     let legs = protocol::Joints::from_leg_fn(|leg| fold.leg(leg).map(f64::from));
     // Wheels (r 0.12 at z −0.15) just on the ground, torso level, wheels unpowered.
-    p.place(0.12 + 0.15 + 0.001, &legs);
+    p.place(0.12 + 0.15 + 0.001, &legs, 0.0);
     let mut max_tilt_deg: f64 = 0.0;
     let mut touched_down = false;
     for _ in 0..2 * STEPS_PER_S {

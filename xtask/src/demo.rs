@@ -19,7 +19,7 @@ use crate::util::{cargo, root, run as sh};
 pub fn run(args: &[String]) -> Result<(), String> {
     let mut bus = "inproc".to_owned();
     let mut out = root().join("out");
-    let mut scenario = None;
+    let mut scenario: Option<std::path::PathBuf> = None;
     let mut render = true;
     let mut teleop = false;
     let mut course = false;
@@ -44,19 +44,18 @@ pub fn run(args: &[String]) -> Result<(), String> {
             }
         }
     }
-    let scenario: std::path::PathBuf = match (course, scenario) {
-        (true, Some(_)) => {
-            return Err(
-                "--course runs scenarios/course.toml: give --course or --scenario FILE, not both"
-                    .to_owned(),
-            )
-        }
-        (true, None) => {
+    if course && scenario.is_some() {
+        return Err(
+            "give --course (scenarios/course.toml) or --scenario FILE, not both".to_owned(),
+        );
+    }
+    let scenario = match scenario {
+        Some(file) => file,
+        None if course => {
             out = out.join("course");
             root().join("scenarios").join("course.toml")
         }
-        (false, Some(file)) => file,
-        (false, None) => root().join("scenarios").join("report_demo.toml"),
+        None => root().join("scenarios").join("report_demo.toml"),
     };
     crate::setup::run()?;
     if teleop {

@@ -80,6 +80,8 @@ impl CycleRecord {
 #[derive(Debug)]
 pub struct Rig {
     model: PathBuf,
+    /// How the robot starts, and starts again after a simulator restart.
+    start: StartPose,
     sim: Simulator,
     sim_bus: FaultyBus<InprocEndpoint>,
     controller: Option<InprocController>,
@@ -118,7 +120,19 @@ impl Rig {
         teleop_faults: &Faults,
         plant: Plant,
     ) -> Result<Self, SessionError> {
-        let sim = Simulator::new(model, RIG_HZ, StartPose::standing(), plant)?;
+        let start = StartPose::standing();
+        Self::with_start(model, plan, (faults, teleop_faults), plant, start)
+    }
+
+    /// As [`Rig::with_plant`], the robot starting at `start` (standing, turned to a heading).
+    pub fn with_start(
+        model: &Path,
+        plan: Vec<PlanStep>,
+        (faults, teleop_faults): (&Faults, &Faults),
+        plant: Plant,
+        start: StartPose,
+    ) -> Result<Self, SessionError> {
+        let sim = Simulator::new(model, RIG_HZ, start, plant)?;
         let bus = InprocBus::new();
         let sim_bus = FaultyBus::new(bus.endpoint(), &plant.link_faults(faults));
         let firmware = firmware_config(RIG_HZ).ok_or(SessionError::ControlRate(RIG_HZ))?;
@@ -130,6 +144,7 @@ impl Rig {
         Ok(Self {
             bus,
             model: model.to_owned(),
+            start,
             sim,
             sim_bus,
             controller: Some(controller),
@@ -283,7 +298,7 @@ impl Rig {
     pub fn restart_simulator(&mut self) -> Result<(), SessionError> {
         // (The firmware keeps running: its counters go on.)
         let plant = *self.sim.plant();
-        self.sim = Simulator::new(&self.model, RIG_HZ, StartPose::standing(), plant)?;
+        self.sim = Simulator::new(&self.model, RIG_HZ, self.start, plant)?;
         Ok(())
     }
 

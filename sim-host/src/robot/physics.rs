@@ -138,14 +138,16 @@ impl Physics {
             && self.data.qvel().iter().all(|v| v.is_finite())
     }
 
-    /// Places the torso at `height_m` (level, at the origin, at rest) with the leg joints at
-    /// `leg_joint_rad` and their servo targets there too.
-    pub fn place(&mut self, height_m: f64, leg_joint_rad: &Joints<f64>) {
+    /// Places the torso at `height_m` (level, at the origin, at rest, turned `heading_rad`
+    /// about the vertical) with the leg joints at `leg_joint_rad` and their servo targets
+    /// there too.
+    pub fn place(&mut self, height_m: f64, leg_joint_rad: &Joints<f64>, heading_rad: f64) {
         self.data.reset();
         let layout = self.layout.clone();
         {
             let qpos = self.data.qpos_mut();
-            qpos[..7].copy_from_slice(&[0.0, 0.0, height_m, 1.0, 0.0, 0.0, 0.0]);
+            let (sin, cos) = (heading_rad / 2.0).sin_cos();
+            qpos[..7].copy_from_slice(&[0.0, 0.0, height_m, cos, 0.0, 0.0, sin]);
             for (adr, angle) in layout.leg_qpos.iter().zip(leg_joint_rad) {
                 qpos[*adr] = *angle;
             }

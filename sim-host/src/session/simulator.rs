@@ -21,6 +21,9 @@ pub struct StartPose {
     pub height_m: f64,
     /// Leg joint angles, rad.
     pub leg_joint_rad: Joints<f64>,
+    /// The torso's heading, rad about the vertical (0: facing +x, along the scenes' path,
+    /// square to their obstacles; + turned left).
+    pub heading_rad: f64,
 }
 
 impl StartPose {
@@ -37,6 +40,15 @@ impl StartPose {
         Self {
             height_m: f64::from(depth_m) + FOOT_RADIUS_M,
             leg_joint_rad: Joints::from_leg_fn(|_| leg.map(f64::from)),
+            heading_rad: 0.0,
+        }
+    }
+
+    /// This pose turned to `heading_rad`: the scene's obstacles met at that angle.
+    pub fn turned(self, heading_rad: f64) -> Self {
+        Self {
+            heading_rad,
+            ..self
         }
     }
 }
@@ -91,7 +103,7 @@ impl Simulator {
                 period_s,
             });
         }
-        physics.place(start.height_m, &start.leg_joint_rad);
+        physics.place(start.height_m, &start.leg_joint_rad, start.heading_rad);
         let hardware = Hardware::new(control_hz, plant, &physics.layout().leg_range_rad, key);
         Ok(Self {
             physics,

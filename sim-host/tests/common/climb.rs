@@ -12,6 +12,7 @@ use sim_host::campaign::Drives;
 use sim_host::faults::rig::Rig;
 use sim_host::robot::model::DEFAULT_MODEL;
 use sim_host::scene::{mjcf, Scene, Step};
+use sim_host::session::simulator::StartPose;
 use teleop_core::scripted::PlanStep;
 
 /// Height of the torso's origin over the ground balancing on the wheels, m.
@@ -36,6 +37,8 @@ pub struct StepBehind {
     pub distance_m: f64,
     /// How deep the plateau is, m: its far edge is a step down as high.
     pub plateau_m: f64,
+    /// The robot's heading to the riser, rad (0: square to it).
+    pub heading_rad: f64,
 }
 
 /// What one trial did.
@@ -125,7 +128,8 @@ fn run_plan(
         depth_m: step.plateau_m,
         behind: true,
     });
-    let mut trial = run_scene(seed, &scene, plan, (mode_at_s, latch_s), end_s);
+    let start = StartPose::standing().turned(step.heading_rad);
+    let mut trial = run_scene_from(seed, &scene, plan, (mode_at_s, latch_s), end_s, start);
     trial.onto_plateau_m = riser_x_m - trial.torso_x_m;
     trial
 }
@@ -140,13 +144,26 @@ pub fn run_scene(
     (mode_at_s, latch_s): (f64, Option<f64>),
     end_s: f64,
 ) -> Trial {
+    let start = StartPose::standing();
+    run_scene_from(seed, scene, plan, (mode_at_s, latch_s), end_s, start)
+}
+
+/// As [`run_scene`], the robot starting at `start` (turned to a heading).
+pub fn run_scene_from(
+    seed: u64,
+    scene: &Scene,
+    plan: Vec<PlanStep>,
+    (mode_at_s, latch_s): (f64, Option<f64>),
+    end_s: f64,
+    start: StartPose,
+) -> Trial {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
         .join("climb")
         .join(format!("{seed}-{}", RUNS.fetch_add(1, Ordering::Relaxed)));
     let model = mjcf::write(scene, Path::new(DEFAULT_MODEL), &dir).unwrap();
     let faults = Faults::default();
     let plant = Draws::of(seed).plant(Drives::Rated.ratings());
-    let mut rig = Rig::with_plant(&model, plan, &faults, &faults, plant).unwrap();
+    let mut rig = Rig::with_start(&model, plan, (&faults, &faults), plant, start).unwrap();
     let (mut fell_at, mut states, mut max_tilt_deg) = (None, Vec::new(), 0.0_f64);
     let mut max_roll_deg = 0.0_f64;
     let mut contacts: Vec<(f64, String)> = Vec::new();
