@@ -264,6 +264,10 @@ impl Climb {
         // stepped down from again, as early as the estimate is sound; a step too low only at
         // the end, where the estimate is best.
         let step_m = self.step_height_m(config, pitch_rad);
+        if pitch_rad > config.rise_pitch_max_rad {
+            self.enter(Phase::Retreat, now);
+            return;
+        }
         if !self.rise_checked && share >= config.rise_check_share {
             self.rise_checked = true;
             if step_m > config.step_max_m {
