@@ -33,8 +33,8 @@ struct Bench {
     now: u32,
     joints_rad: protocol::Joints<f32>,
     wheels: Wheels,
-    /// What the rangefinder ranges every 20 ms, m (`None`: it is silent).
-    ranging_m: Option<f32>,
+    /// What the rangefinder sends every 20 ms (`None`: nothing).
+    ranging: Option<Range>,
 }
 
 impl Bench {
@@ -45,7 +45,7 @@ impl Bench {
             now: 0,
             joints_rad: common::standing_joints_rad(&CONFIG),
             wheels: Wheels::Follow,
-            ranging_m: None,
+            ranging: None,
         };
         bench.run(5);
         bench.send(command(TeleopMode::Stop));
@@ -75,11 +75,8 @@ impl Ticks for Bench {
         for message in plant_feedback_rolling(&self.joints_rad, rate_rad_s) {
             self.send(message);
         }
-        if let Some(distance_m) = self.ranging_m.filter(|_| self.now % 5 == 0) {
-            self.send(AnyMessage::Range(Range {
-                distance: RangeDistance::saturating_from_si(distance_m),
-                status: RangeStatus::Valid,
-            }));
+        if let Some(range) = self.ranging.filter(|_| self.now % 5 == 0) {
+            self.send(AnyMessage::Range(range));
         }
         if self.now % 5 == 0 {
             self.send(AnyMessage::TeleopHeartbeat(TeleopHeartbeat {
@@ -97,6 +94,18 @@ impl Ticks for Bench {
 
 fn ms(ms: u32) -> u32 {
     CONFIG.rate.ticks_from_ms(ms)
+}
+
+/// A ranging of `distance_m` (`None`: no return within the part's range).
+fn range(distance_m: Option<f32>) -> Range {
+    Range {
+        distance: RangeDistance::saturating_from_si(distance_m.unwrap_or(0.0)),
+        status: if distance_m.is_some() {
+            RangeStatus::Valid
+        } else {
+            RangeStatus::SignalFail
+        },
+    }
 }
 
 fn torque_free(output: &Output) -> bool {
@@ -213,7 +222,7 @@ fn following_wheels_never_trip_in_drive_stop_turn_and_reverse() {
 #[test]
 fn the_autonomous_mode_stops_and_says_so_when_the_rangefinder_falls_silent() {
     let mut bench = Bench::on_the_wheels();
-    bench.ranging_m = Some(0.8);
+    bench.ranging = Some(range(Some(0.8)));
     bench.send(command(TeleopMode::Auto));
     for _ in 0..ms(2_000) {
         let output = bench.tick();
@@ -221,7 +230,7 @@ fn the_autonomous_mode_stops_and_says_so_when_the_rangefinder_falls_silent() {
     }
     assert_eq!(bench.state(), State::Wheels(WheelMotion::Auto));
     // Silent: stopped within ten of the part's 20 ms rangings, balancing, the flag up.
-    bench.ranging_m = None;
+    bench.ranging = None;
     let mut stopped_after = None;
     for n in 1..=ms(300) {
         let output = bench.tick();
@@ -244,11 +253,35 @@ fn the_autonomous_mode_stops_and_says_so_when_the_rangefinder_falls_silent() {
     }
     // The operator's next request (a key other than the one held) clears the report, and
     // with the part ranging again the mode drives on.
-    bench.ranging_m = Some(0.8);
+    bench.ranging = Some(range(Some(0.8)));
     bench.send(command(TeleopMode::Stop));
     let output = bench.tick();
     assert!(!output.status.faults.contains(FaultFlags::RANGE_TIMEOUT));
     bench.send(command(TeleopMode::Auto));
     bench.run(ms(500));
     assert_eq!(bench.state(), State::Wheels(WheelMotion::Auto));
+}
+
+#[test]
+fn the_autonomous_mode_stops_when_the_rangefinder_sees_nothing_on_level_ground() {
+    let mut bench = Bench::on_the_wheels();
+    // The part sends its frames, but never with a return (a covered window).
+    bench.ranging = Some(range(None));
+    bench.send(command(TeleopMode::Auto));
+    let mut stopped_after = None;
+    for n in 1..=ms(8_000) {
+        let output = bench.tick();
+        if bench.state() != State::Wheels(WheelMotion::Auto) {
+            assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+            assert!(output.status.faults.contains(FaultFlags::RANGE_TIMEOUT));
+            stopped_after = Some(n);
+            break;
+        }
+    }
+    // 1.5 m at the mode's 0.48 m/s, after the start.
+    let stopped_after = stopped_after.expect("still driving blind after 8 s");
+    assert!(
+        (ms(3_000)..=ms(5_000)).contains(&stopped_after),
+        "stopped after {stopped_after} ticks"
+    );
 }

@@ -293,9 +293,9 @@ wire_flags!(
         /// robot folded back onto its wheels and balances; cleared by the operator's next
         /// request.
         STEP_REFUSED = 13 => "step_refused",
-        /// The autonomous mode heard no ranging from the rangefinder for 0.2 s: it would
-        /// drive blind toward what it cannot see, so the robot stopped and balances; cleared
-        /// by the operator's next request.
+        /// The autonomous mode heard no ranging from the rangefinder for 0.2 s, or none with a
+        /// return over 1.5 m of level ground: it would drive blind toward what it cannot see,
+        /// so the robot stopped and balances; cleared by the operator's next request.
         RANGE_TIMEOUT = 14 => "range_timeout",
     }
 );

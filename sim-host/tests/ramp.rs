@@ -96,3 +96,69 @@ fn in_the_autonomous_mode_the_robot_rolls_up_and_down_a_10_degree_ramp() {
     assert_eq!(fell, 0);
     assert!(crossings * 100 >= 95 * TRIALS, "{crossings} of {TRIALS}");
 }
+
+/// How far a robot stopped on the slope may roll back before it holds, m (measured: up to
+/// 0.21 m on robots 0–7, as the law brakes and the trim follows the slope's lean within its
+/// band), …
+const SAG_M: f64 = 0.3;
+
+/// … and how far it may move in the last 4 s of the 9 after the stop, m (measured: up to
+/// 0.08 m, the trim still settling; one that runs down the slope goes metres).
+const HOLD_M: f64 = 0.12;
+
+/// A STOP halfway up the ramp: the robot stays on its wheels with its legs clear, balancing,
+/// rolls back a little as it brakes and then holds its place on the slope, for the first 8
+/// robots; none runs down the slope nor falls.
+#[test]
+fn stopped_halfway_up_the_ramp_the_robot_holds_its_place() {
+    for seed in 0..8 {
+        let ramp = ramp(seed);
+        let plan = vec![
+            PlanStep::at(0.0, TeleopMode::Fold),
+            PlanStep::at(MODE_AT_S, TeleopMode::Auto),
+        ];
+        let scene = Scene::Ramp(ramp);
+        let up = run_scene(seed, &scene, plan.clone(), (MODE_AT_S, None), END_S);
+        // Halfway up: the torso 13 cm above where it rides on level ground.
+        let Some(&(stop_s, stop_x_m, _)) =
+            up.path.0.iter().find(|&&(_, _, z)| z > ON_WHEELS_M + 0.13)
+        else {
+            panic!("seed {seed} never got halfway up: {up:?}");
+        };
+        let mut plan = plan;
+        plan.push(PlanStep::at(stop_s, TeleopMode::Stop));
+        let end_s = stop_s + 9.0;
+        let stopped = run_scene(seed, &scene, plan, (MODE_AT_S, None), end_s);
+        let after = |from_s: f64| {
+            stopped
+                .path
+                .0
+                .iter()
+                .filter(move |&&(t, _, _)| t >= from_s)
+                .map(|&(_, x, _)| x)
+        };
+        // Backward is −x: rolling back down the ramp is +x.
+        let sag_m = after(stop_s).fold(f64::NEG_INFINITY, f64::max) - stop_x_m;
+        let last = || after(end_s - 4.0);
+        let moved_m =
+            last().fold(f64::NEG_INFINITY, f64::max) - last().fold(f64::INFINITY, f64::min);
+        println!(
+            "MEASURED ramp stop, seed {seed}: stopped at {stop_s:.1} s, rolled back {sag_m:.3} m, then moved {moved_m:.3} m in the last 4 s, states {:?}",
+            stopped.states
+        );
+        assert!(stopped.fell_at.is_none(), "seed {seed}: {stopped:?}");
+        assert_eq!(
+            stopped.last(),
+            Some(State::Wheels(WheelMotion::Balance)),
+            "seed {seed}: {stopped:?}"
+        );
+        assert!(
+            sag_m <= SAG_M,
+            "seed {seed} rolled back {sag_m:.2} m: {stopped:?}"
+        );
+        assert!(
+            moved_m <= HOLD_M,
+            "seed {seed} moved {moved_m:.2} m: {stopped:?}"
+        );
+    }
+}

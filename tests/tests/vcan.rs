@@ -77,8 +77,8 @@ fn all_30_mode_pairs_over_vcan_keep_the_robot_up_and_in_limits() {
 }
 
 /// The obstacle course in the autonomous mode, the firmware its own process on kernel vcan:
-/// the step climbed and left behind, then the ramp rolled over. The scenario gives the mode
-/// 56 s, so a crossing at all is one within the 60 s.
+/// the step climbed and left behind, then the ramp rolled over, within the 60 s (the
+/// scenario's 56 s of the mode bound it today; the check stays for a longer scenario).
 #[test]
 fn the_course_over_vcan_is_crossed_end_to_end_in_the_autonomous_mode() {
     let bus = Vcan::new();
@@ -103,7 +103,7 @@ fn the_course_over_vcan_is_crossed_end_to_end_in_the_autonomous_mode() {
     println!(
         "course over vcan: the step left behind {step_s:.1} s and the ramp {ramp_s:.1} s after the mode began, climbs {climbs:?}"
     );
-    assert!(step_s < ramp_s, "{auto}");
+    assert!(step_s < ramp_s && ramp_s <= 60.0, "{auto}");
     assert_eq!(climbs.len(), 1, "{auto}");
     assert_eq!(summary["missed_cycles"].as_u64(), Some(0), "{summary}");
 }

@@ -375,9 +375,11 @@ impl Controller {
     }
 
     fn apply(&mut self, event: Event) {
-        if matches!(event, Event::Request(_)) && !matches!(self.state, State::EStop | State::Fault)
-        {
-            // The operator has seen the stop and asks for something: the report has served.
+        let request = matches!(event, Event::Request(_))
+            && !matches!(self.state, State::EStop | State::Fault);
+        if request || event == Event::Reset {
+            // The operator has seen the stop and asks for something (or resets a fault): the
+            // report has served.
             self.leg_blocked = false;
             self.auto.step_refused = false;
             self.auto.range_lost = false;

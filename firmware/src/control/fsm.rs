@@ -7,11 +7,12 @@
 //! # Transition table
 //!
 //! `Request(·)` is an operator request (teleop frame); `TeleopLost`, `LinkDegraded`,
-//! `LegBlocked`, `StepRefused` and `RangeLost` are stop requests the controller makes itself. `Legs(m)` and `Wheels(m)` are the
-//! steady states, `Standing(m)` / `Folding(m)` the transitions that end in them on `PoseReached`.
+//! `LegBlocked`, `StepRefused` and `RangeLost` are stop requests the controller makes itself.
+//! `Legs(m)` and `Wheels(m)` are the steady states, `Standing(m)` / `Folding(m)` the
+//! transitions that end in them on `PoseReached`.
 //! `—` means the event leaves the state unchanged.
 //!
-//! | state ↓ / event →  | Stop (X), `TeleopLost`, `LinkDegraded`, `LegBlocked`, `StepRefused`, `RangeLost` | Stand          | Trot d (L/K/Walk) | Fold             | Wheel w (W/S/A/Drive/H) | `PoseReached` |
+//! | state ↓ / event →  | Stop (X), or a stop of the controller's            | Stand          | Trot d (L/K/Walk) | Fold             | Wheel w (W/S/A/Drive/H) | `PoseReached` |
 //! |--------------------|----------------------------------------------------|----------------|-------------------|------------------|-------------------|---------------|
 //! | `Hold`             | —                                                    | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | —             |
 //! | `Legs(_)`          | Legs(Stand)                                          | Legs(Stand)    | Legs(Trot d)      | Folding(Balance) | Folding(w)        | —             |

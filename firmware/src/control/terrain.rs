@@ -49,10 +49,11 @@ pub struct TerrainConfig {
     /// changing at the beam's grade, tan(25° − pitch); a 10° slope changes at its own,
     /// tan 10°. A robot leaning 10° nose down brings the two within 0.66 of each other.
     pub steep_share: f32,
-    /// The beam must meet level ground at least this steeply for a decision, rad: below it a
-    /// 10° slope's grade comes within [`Self::steep_share`] of the beam's own, and the two
-    /// cannot be told apart (a robot leaning 14° nose down looks back 11° down, and read a
-    /// ramp there as a riser); the watch then decides nothing.
+    /// The beam must meet level ground at least this steeply for a decision between a slope
+    /// and an edge, rad: below it a 10° slope's grade comes within [`Self::steep_share`] of
+    /// the beam's own, and the two cannot be told apart (a robot leaning 14° nose down looks
+    /// back 11° down, and read a ramp there as a riser); the watch then waits for a steeper
+    /// ranging, and decides meanwhile only a riser's face, which rises far faster.
     pub min_beam_rad: f32,
     /// How much of each new level height the learned level takes, per ranging.
     pub level_gain: f32,
@@ -141,6 +142,11 @@ struct Mark {
     rise_m: f32,
 }
 
+/// A height that changed by more than this share of what the beam's own grade gives over the
+/// spot's run is a riser's face however shallow the beam: an edge's jump and a slope both
+/// change it at no more than the beam's grade.
+const RISER_SHARE: f32 = 1.5;
+
 /// Rangings in a row back at the level that end a feature's onset (a pitch wobble).
 const BACK_LEVEL_RANGINGS: u8 = 3;
 
@@ -187,10 +193,10 @@ impl TerrainWatch {
             return None;
         };
         let (height_m, behind_m) = Self::spot_m(config, distance_m, ranging.pitch_rad);
-        if !height_m.is_finite() || !behind_m.is_finite() {
+        let along_m = ranging.backed_m + behind_m;
+        if !height_m.is_finite() || !along_m.is_finite() {
             return None;
         }
-        let along_m = ranging.backed_m + behind_m;
         if let Some(until_m) = self.quiet_until_m {
             if along_m < until_m {
                 return None;
@@ -265,17 +271,22 @@ impl TerrainWatch {
         // sweeps it up onto an edge standing still.
         let backed_m = (here.backed_m - mark.backed_m).abs();
         let swept = here.rise_m > 0.0 && backed_m < 0.5 * run_m;
-        self.reset();
-        self.quiet_until_m = Some(here.along_m + config.quiet_m);
         // The beam meets level ground at its depression less the pitch (nose down lifts the
         // rear face's beam toward the horizontal).
         let beam_rad = config.depression_rad - pitch_rad;
-        if beam_rad < config.min_beam_rad {
+        let (sin, cos) = crate::math::sin_cos(beam_rad);
+        let beam_change_m = run_m * sin / cos;
+        let change_m = (here.rise_m - mark.rise_m).abs();
+        // Too shallow to tell a slope from an edge, only a change well past the beam's own
+        // grade is sure (a riser's face); the rest waits, the feature still open, for a
+        // ranging from a steadier body.
+        let riser = beam_rad > 0.0 && change_m > RISER_SHARE * beam_change_m;
+        if beam_rad < config.min_beam_rad && !riser {
             return None;
         }
-        let (sin, cos) = crate::math::sin_cos(beam_rad);
-        let change_m = (here.rise_m - mark.rise_m).abs();
-        let slope = change_m < config.steep_share * run_m * sin / cos && !swept;
+        self.reset();
+        self.quiet_until_m = Some(here.along_m + config.quiet_m);
+        let slope = change_m < config.steep_share * beam_change_m && !swept;
         let rise_m = here.rise_m;
         Some(if slope {
             Feature::Slope { rise_m }

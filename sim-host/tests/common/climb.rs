@@ -65,6 +65,18 @@ pub struct Trial {
     pub climb_start_x_m: Option<f64>,
     /// Every fault the controller reported after the mode was sent.
     pub faults: FaultFlags,
+    /// The torso's place each cycle.
+    pub path: TorsoPath,
+}
+
+/// The torso's place each cycle: time, s, and x and z, m. Its debug form is its length, so
+/// that a trial printed whole stays readable.
+pub struct TorsoPath(pub Vec<(f64, f64, f64)>);
+
+impl std::fmt::Debug for TorsoPath {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "TorsoPath({} cycles)", self.0.len())
+    }
 }
 
 impl Trial {
@@ -169,6 +181,7 @@ pub fn run_scene_from(
     let mut contacts: Vec<(f64, String)> = Vec::new();
     let (mut faults, mut climb_start_x_m) = (FaultFlags::EMPTY, None);
     let mut latch_s = latch_s;
+    let mut path = Vec::new();
     while rig.time_s() < end_s {
         if latch_s.is_some_and(|at_s| rig.time_s() >= at_s) {
             latch_s = None;
@@ -192,6 +205,8 @@ pub fn run_scene_from(
             }
         }
         let physics = rig.sim().physics();
+        let pos_m = physics.torso().pos_m;
+        path.push((rig.time_s(), pos_m[0], pos_m[2]));
         if rig.time_s() > mode_at_s {
             faults = faults.with(record.faults);
             max_tilt_deg = max_tilt_deg.max(record.tilt_deg);
@@ -217,5 +232,6 @@ pub fn run_scene_from(
         torso_x_m: torso.pos_m[0],
         climb_start_x_m,
         faults,
+        path: TorsoPath(path),
     }
 }

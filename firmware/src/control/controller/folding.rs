@@ -136,19 +136,20 @@ impl Controller {
 
     /// Which of the balance law's trim rules may learn now: from the position error only on
     /// the wheels, the following of the balance point also in a fold whose legs are tucked;
-    /// riding clear of a slope, the slope's rules ([`super::riding::Riding::trim_band_rad`]).
+    /// riding clear of a slope, the trim's band ([`super::riding::Riding::trim_band_rad`]) and
+    /// in the autonomous mode forgiving ([`super::riding::Riding::forgive_s`]).
     pub(super) fn set_trim_rules(&mut self, now: Tick) {
         let wheels = matches!(self.state, State::Wheels(_));
         let tucked = matches!(self.state, State::Folding(_)) && self.fold_done_at.is_some();
         self.balance.set_trim_learning(wheels);
         self.balance.set_trim_following(wheels || tucked);
         // Only riding clear: the comparison of 16 joints is no work for every tick.
+        let settled = wheels && self.auto.riding.clear() && self.legs_at_goal();
         let rules = self.slope_rules();
-        let settled = rules && self.legs_at_goal();
         let rate = self.config.rate;
         let riding = &mut self.auto.riding;
         self.balance
-            .set_trim_band(riding.trim_band_rad(rate, now, rules, settled));
+            .set_trim_band(riding.trim_band_rad(rate, now, settled));
         self.balance.set_forgiving(riding.forgive_s(rules));
         let in_place = matches!(self.state, State::Wheels(WheelMotion::Balance));
         self.balance

@@ -14,12 +14,13 @@
 //! the wheels reach its foot, and braking and moving the legs' mass roll the robot on
 //! 0.1–0.2 m (0.5 m on the heaviest-legged robots).
 //!
-//! Riding clear in the autonomous mode ([`Controller::slope_rules`]), the stall watch waits longer for a robot standing still against its
-//! reference ([`crate::wheels::runaway::Runaway::set_patient`]: one starting up a slope leans
-//! into it for a second or more first), a stall that leaves the robot rolling is the foot of a
-//! slope, not a riser (`wheel_law`), and the balance law keeps its trim within a band and
-//! forgives a position error it is making up ([`Riding::trim_band_rad`],
-//! [`Riding::forgive_s`]).
+//! Riding clear in the autonomous mode ([`Controller::slope_rules`]), the stall watch waits
+//! longer for a robot standing still against its reference
+//! ([`crate::wheels::runaway::Runaway::set_patient`]: one starting up a slope leans into it
+//! for a second or more first), a stall that leaves the robot rolling is the foot of a
+//! slope, not a riser (`wheel_law`), and the balance law forgives a position error it is
+//! making up ([`Riding::forgive_s`]); riding clear in any wheeled mode, it keeps its trim
+//! within a band ([`Riding::trim_band_rad`]).
 
 use super::Controller;
 use crate::control::fsm::{Event, State, WheelMotion};
@@ -64,6 +65,12 @@ const REPOSE_SLOW_M_S: f32 = 0.1;
 /// 50 Hz rangings (a lossy bus drops one now and then; a silent part drops them all).
 const RANGE_TIMEOUT_MS: u32 = 200;
 
+/// … and once it has backed this far on level ground with no return from the part, m: the
+/// part sends its frames but sees nothing (a covered window, a dead emitter). Level ground is
+/// 0.8 m along the beam; only a slope going down, where the robot leans off its trim, or the
+/// crest before one, where the beam runs past its far foot for up to 0.8 m, gives none.
+const BLIND_M: f32 = 1.5;
+
 /// A change of pose under way.
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Repose {
@@ -88,6 +95,10 @@ pub(super) struct Riding {
     settled_since: Option<Tick>,
     /// Ticks in the mode since the last ranging.
     silent_ticks: u32,
+    /// Whether the last ranging had no return.
+    no_return: bool,
+    /// How far the robot has backed on level ground since a ranging last had a return, m.
+    blind_m: f32,
 }
 
 impl Riding {
@@ -112,20 +123,22 @@ impl Riding {
         if next != State::Wheels(WheelMotion::Auto) {
             self.repose = None;
             self.watch.reset();
+            self.backed_m = 0.0;
+            self.blind_m = 0.0;
         }
     }
 
-    /// The band the trim follows the balance point within (`None`: any): riding clear in the
-    /// autonomous mode (`rules`: [`Controller::slope_rules`]), once the legs have settled for
-    /// [`TRIM_SETTLE_MS`] (`settled`: at their goal now).
+    /// The band the trim follows the balance point within (`None`: any): riding clear, in any
+    /// wheeled mode (a robot stopped on a slope leans as it did rolling up it, and a trim that
+    /// took that lean would run it down), once the legs have settled for [`TRIM_SETTLE_MS`]
+    /// (`settled`: at their goal now).
     pub(super) fn trim_band_rad(
         &mut self,
         rate: TickRate,
         now: Tick,
-        rules: bool,
         settled: bool,
     ) -> Option<f32> {
-        self.settled_since = if rules && settled {
+        self.settled_since = if self.clear && settled {
             self.settled_since.or(Some(now))
         } else {
             None
@@ -144,8 +157,10 @@ impl Riding {
 }
 
 impl Controller {
-    /// Whether the slope's rules apply: riding clear in the autonomous mode. Legs left clear
-    /// under a manual drive keep their pose, but the robot is driven as anywhere else.
+    /// Whether the slope's driving rules apply (the patient stall watch, rolling on at a
+    /// slope's foot, forgiving a position error): riding clear in the autonomous mode. Legs
+    /// left clear under a manual drive or a stop keep their pose and the trim's band, but the
+    /// robot is driven as anywhere else.
     pub(super) fn slope_rules(&self) -> bool {
         self.auto.riding.clear() && self.state == State::Wheels(WheelMotion::Auto)
     }
@@ -154,25 +169,46 @@ impl Controller {
     /// received this tick (`None`: none; the caller consumes it in every state): a slope or a
     /// step decided starts a change of pose if the legs ride the other way; a change under way
     /// ends once the legs are there and the robot has stood still for [`REPOSE_STILL_MS`], or
-    /// after [`REPOSE_MAX_MS`]. No ranging for [`RANGE_TIMEOUT_MS`] stops the mode
-    /// (`RANGE_TIMEOUT`).
+    /// after [`REPOSE_MAX_MS`]. A rangefinder that has gone quiet ([`Self::range_lost_now`])
+    /// stops the mode (`RANGE_TIMEOUT`).
     #[inline(never)] // Its frame stays off the control step's deepest path (PIL stack budget).
     pub(super) fn ride_step(&mut self, now: Tick, dt_s: f32, ranging: Option<Option<f32>>) {
         let speed_m_s = self.ground_speed_m_s();
         self.auto.riding.backed_m -= speed_m_s * dt_s;
         if let Some(distance_m) = ranging {
-            self.auto.riding.silent_ticks = 0;
+            let riding = &mut self.auto.riding;
+            riding.silent_ticks = 0;
+            riding.no_return = distance_m.is_none();
+            if distance_m.is_some() {
+                riding.blind_m = 0.0;
+            }
             self.watch_ranging(now, distance_m);
         } else {
-            let silent = self.auto.riding.silent_ticks.saturating_add(1);
-            self.auto.riding.silent_ticks = silent;
-            if silent >= self.config.rate.ticks_from_ms(RANGE_TIMEOUT_MS) {
-                self.apply(Event::RangeLost);
-                self.auto.range_lost = true;
-                return;
-            }
+            self.auto.riding.silent_ticks = self.auto.riding.silent_ticks.saturating_add(1);
+        }
+        if self.auto.riding.no_return && self.leans_at_trim() {
+            self.auto.riding.blind_m += speed_m_s.abs() * dt_s;
+        }
+        if self.range_lost_now() {
+            self.apply(Event::RangeLost);
+            self.auto.range_lost = true;
+            return;
         }
         self.repose_step(now, speed_m_s);
+    }
+
+    /// Whether the rangefinder has gone quiet: no ranging for [`RANGE_TIMEOUT_MS`], or none
+    /// with a return over [`BLIND_M`] of level ground.
+    fn range_lost_now(&self) -> bool {
+        let riding = &self.auto.riding;
+        riding.silent_ticks >= self.config.rate.ticks_from_ms(RANGE_TIMEOUT_MS)
+            || riding.blind_m >= BLIND_M
+    }
+
+    /// Whether the body leans within [`TRIM_BAND_RAD`] of its trim: on level ground.
+    fn leans_at_trim(&self) -> bool {
+        let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
+        lean_rad.abs() < TRIM_BAND_RAD
     }
 
     /// Reads one ranging into the terrain watch, and starts a change of pose for what it
@@ -185,6 +221,9 @@ impl Controller {
             && !self
                 .traction
                 .fell_within(self.config.rate.ticks_from_ms(LANDED_MS));
+        // Back into the fold only on level ground: on a slope the robot leans off its trim,
+        // and stopping there to fold meets the slope with the fold's shanks.
+        let level = self.leans_at_trim();
         let riding = &mut self.auto.riding;
         // The legs that move in a change of pose pitch the body as they go: what the beam
         // sees meanwhile is no ground's.
@@ -197,10 +236,6 @@ impl Controller {
             pitch_rad: self.sensors.attitude.pitch_rad,
             backed_m: riding.backed_m,
         };
-        // Back into the fold only on level ground: on a slope the robot leans off its trim,
-        // and stopping there to fold meets the slope with the fold's shanks.
-        let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
-        let level = lean_rad.abs() < TRIM_BAND_RAD;
         // Up only: down a slope the legs already ride clear (the robot came up one), and off
         // an edge the spot jumps along the beam by a run that the body's pitch can make look
         // like a slope's; an edge needs no fold (the legs ride clear of it).
@@ -236,6 +271,7 @@ impl Controller {
                 repose.since = now;
             } else if now.since(repose.since) >= max_ticks {
                 self.auto.riding.repose = None;
+                self.runaway.reset();
                 return;
             }
         }

@@ -290,3 +290,20 @@ fn looking_back_too_shallow_to_tell_a_ramp_from_a_riser_decides_nothing() {
     let found = back_over_leaning(ramp, 1.4, 14.0 * DEG, 0.5 * DEG, 0.0, 0.005);
     assert!(found.is_empty(), "{found:?}");
 }
+
+#[test]
+fn looking_back_shallow_a_riser_is_still_a_step() {
+    // The beam 12–13° down: a riser's face rises with the spot standing still, far faster
+    // than any slope or edge changes the height.
+    for lean_deg in [12.0, 13.0] {
+        let riser = Ground::Riser {
+            at_m: 1.5,
+            height_m: 0.10,
+        };
+        let found = back_over_leaning(riser, 2.0, lean_deg * DEG, 0.5 * DEG, 0.0, 0.005);
+        assert!(
+            matches!(found.first(), Some((_, Feature::Step { rise_m })) if *rise_m > 0.0),
+            "{lean_deg}°: {found:?}"
+        );
+    }
+}
