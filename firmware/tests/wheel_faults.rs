@@ -219,6 +219,20 @@ fn following_wheels_never_trip_in_drive_stop_turn_and_reverse() {
     }
 }
 
+/// Runs `bench` in the autonomous mode for at most `limit` ticks; the tick at which the mode
+/// stopped for its rangefinder (balancing, `range_timeout` reported), `None` if it drove on.
+fn until_range_stop(bench: &mut Bench, limit: u32) -> Option<u32> {
+    for n in 1..=limit {
+        let output = bench.tick();
+        if bench.state() != State::Wheels(WheelMotion::Auto) {
+            assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
+            assert!(output.status.faults.contains(FaultFlags::RANGE_TIMEOUT));
+            return Some(n);
+        }
+    }
+    None
+}
+
 #[test]
 fn the_autonomous_mode_stops_and_says_so_when_the_rangefinder_falls_silent() {
     let mut bench = Bench::on_the_wheels();
@@ -231,17 +245,8 @@ fn the_autonomous_mode_stops_and_says_so_when_the_rangefinder_falls_silent() {
     assert_eq!(bench.state(), State::Wheels(WheelMotion::Auto));
     // Silent: stopped within ten of the part's 20 ms rangings, balancing, the flag up.
     bench.ranging = None;
-    let mut stopped_after = None;
-    for n in 1..=ms(300) {
-        let output = bench.tick();
-        if bench.state() != State::Wheels(WheelMotion::Auto) {
-            assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
-            assert!(output.status.faults.contains(FaultFlags::RANGE_TIMEOUT));
-            stopped_after = Some(n);
-            break;
-        }
-    }
-    let stopped_after = stopped_after.expect("still driving blind after 0.3 s");
+    let stopped_after =
+        until_range_stop(&mut bench, ms(300)).expect("still driving blind after 0.3 s");
     assert!(
         stopped_after >= ms(180),
         "stopped after {stopped_after} ticks"
@@ -268,18 +273,9 @@ fn the_autonomous_mode_stops_when_the_rangefinder_sees_nothing_on_level_ground()
     // The part sends its frames, but never with a return (a covered window).
     bench.ranging = Some(range(None));
     bench.send(command(TeleopMode::Auto));
-    let mut stopped_after = None;
-    for n in 1..=ms(8_000) {
-        let output = bench.tick();
-        if bench.state() != State::Wheels(WheelMotion::Auto) {
-            assert_eq!(bench.state(), State::Wheels(WheelMotion::Balance));
-            assert!(output.status.faults.contains(FaultFlags::RANGE_TIMEOUT));
-            stopped_after = Some(n);
-            break;
-        }
-    }
     // 1.5 m at the mode's 0.48 m/s, after the start.
-    let stopped_after = stopped_after.expect("still driving blind after 8 s");
+    let stopped_after =
+        until_range_stop(&mut bench, ms(8_000)).expect("still driving blind after 8 s");
     assert!(
         (ms(3_000)..=ms(5_000)).contains(&stopped_after),
         "stopped after {stopped_after} ticks"

@@ -80,7 +80,7 @@ fn a_bad_drive_step_is_rejected_with_the_accepted_keys() {
     let stderr = String::from_utf8_lossy(&result.stderr);
     assert_eq!(result.status.code(), Some(2), "{stderr}");
     assert!(
-        stderr.contains("use W S A L K X, stand, fold, drive or walk"),
+        stderr.contains(teleop_core::scenario::MODE_NAMES),
         "{stderr}"
     );
 }

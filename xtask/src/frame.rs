@@ -136,7 +136,10 @@ fn parse(args: &[String]) -> Result<Request, String> {
             }
             other if kind == "command" && mode.is_none() && !other.starts_with("--") => {
                 mode = Some(teleop_core::scenario::parse_mode(other).ok_or_else(|| {
-                    format!("unknown mode `{other}`: use W S A L K X, stand, fold, drive or walk")
+                    format!(
+                        "unknown mode `{other}`: use {}",
+                        teleop_core::scenario::MODE_NAMES
+                    )
                 })?);
             }
             other => return Err(format!("unknown option `{other}`\n{USAGE}")),

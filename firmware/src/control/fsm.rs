@@ -12,16 +12,16 @@
 //! transitions that end in them on `PoseReached`.
 //! `—` means the event leaves the state unchanged.
 //!
-//! | state ↓ / event →  | Stop (X), or a stop of the controller's            | Stand          | Trot d (L/K/Walk) | Fold             | Wheel w (W/S/A/Drive/H) | `PoseReached` |
-//! |--------------------|----------------------------------------------------|----------------|-------------------|------------------|-------------------|---------------|
-//! | `Hold`             | —                                                    | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | —             |
-//! | `Legs(_)`          | Legs(Stand)                                          | Legs(Stand)    | Legs(Trot d)      | Folding(Balance) | Folding(w)        | —             |
-//! | `Standing(_)`      | Standing(Stand)                                      | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Legs(m)       |
-//! | `Folding(_)`       | Folding(Balance)                                     | Standing(Stand)| Standing(Trot d)  | Folding(Balance) | Folding(w)        | Wheels(m)     |
-//! | `Wheels(_)`        | Wheels(Balance)                                      | Standing(Stand)| Standing(Trot d)  | —                | Wheels(w)         | —             |
-//! | `Climbing(_)`      | Climbing(Balance)                                    | —              | —                 | —                | —                 | Folding(m)    |
-//! | `EStop`            | —                                                    | —              | —                 | —                | —                 | —             |
-//! | `Fault`            | —                                                    | —              | —                 | —                | —                 | —             |
+//! | state ↓ / event → | Stop (X), or a stop of the controller's | Stand           | Trot d (L/K/Walk) | Fold             | Wheel w (W/S/A/Drive/H) | `PoseReached` |
+//! |-------------------|-----------------------------------------|-----------------|-------------------|------------------|-------------------------|---------------|
+//! | `Hold`            | —                                       | Standing(Stand) | Standing(Trot d)  | Folding(Balance) | Folding(w)              | —             |
+//! | `Legs(_)`         | Legs(Stand)                             | Legs(Stand)     | Legs(Trot d)      | Folding(Balance) | Folding(w)              | —             |
+//! | `Standing(_)`     | Standing(Stand)                         | Standing(Stand) | Standing(Trot d)  | Folding(Balance) | Folding(w)              | Legs(m)       |
+//! | `Folding(_)`      | Folding(Balance)                        | Standing(Stand) | Standing(Trot d)  | Folding(Balance) | Folding(w)              | Wheels(m)     |
+//! | `Wheels(_)`       | Wheels(Balance)                         | Standing(Stand) | Standing(Trot d)  | —                | Wheels(w)               | —             |
+//! | `Climbing(_)`     | Climbing(Balance)                       | —               | —                 | —                | —                       | Folding(m)    |
+//! | `EStop`           | —                                       | —               | —                 | —                | —                       | —             |
+//! | `Fault`           | —                                       | —               | —                 | —                | —                       | —             |
 //!
 //! `Walk` requests `LegMotion::Walk` (the trot at the operator's speed and yaw rate) where the
 //! table says `Trot d`, and `Drive` requests `WheelMotion::Velocity` and `Auto` (`H`)

@@ -111,6 +111,9 @@ struct RawStep {
     label: Option<String>,
 }
 
+/// The modes [`parse_mode`] accepts, as an error message names them.
+pub const MODE_NAMES: &str = "W S A L K X, stand, fold, drive, walk or auto";
+
 /// The mode a scenario (or `--drive`) names: the report's keys W S A L K X, `stand`, `fold`,
 /// `drive` and `walk` (at a ground speed and yaw rate), and `auto` (the autonomous hybrid
 /// mode, `H` in the teleop).
@@ -171,8 +174,7 @@ pub fn parse_drive_step(text: &str) -> Result<PlanStep, String> {
     }
     let mut parts = rest.split(',');
     let mode_text = parts.next().unwrap_or_default();
-    let mode = parse_mode(mode_text)
-        .ok_or_else(|| format!("`{mode_text}`: use W S A L K X, stand, fold, drive or walk"))?;
+    let mode = parse_mode(mode_text).ok_or_else(|| format!("`{mode_text}`: use {MODE_NAMES}"))?;
     let mut step = PlanStep::at(seconds, mode);
     for part in parts {
         let (key, value) = part
@@ -324,10 +326,7 @@ impl Source<'_> {
         let mode = parse_mode(s.mode.get_ref()).ok_or_else(|| {
             self.value_error(
                 s.mode.span().start,
-                format!(
-                    "mode = \"{}\": use W, S, A, L, K, X, stand, fold, drive or walk",
-                    s.mode.get_ref()
-                ),
+                format!("mode = \"{}\": use {MODE_NAMES}", s.mode.get_ref()),
             )
         })?;
         let body_height_m = self.in_range(&s.body_height_m, -0.10..=0.12, 0.0, |v| {
@@ -451,7 +450,7 @@ mod tests {
     #[test]
     fn errors_name_the_line() {
         let cases = [
-            ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"Q\"\n", 4, "use W, S, A"),
+            ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"Q\"\n", 4, "use W S A L K X, stand, fold, drive, walk or auto"),
             ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"W\"\n[[step]]\nat_s = 0\nmode = \"X\"\n", 6, "not after"),
             ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"W\"\nbody_height_m = 0.3\n", 5, "−0.10…+0.12"),
             ("duration_s = 6\n[[step]]\nat_s = 9\nmode = \"W\"\n", 3, "duration_s"),

@@ -293,3 +293,57 @@ impl Controller {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const RATE: TickRate = TickRate::SIM_250_HZ;
+
+    fn riding_clear() -> Riding {
+        Riding {
+            clear: true,
+            ..Riding::default()
+        }
+    }
+
+    #[test]
+    fn the_trim_band_holds_only_once_clear_legs_have_settled_long_enough() {
+        let mut folded = Riding::default();
+        assert_eq!(folded.trim_band_rad(RATE, Tick(0), true), None);
+        let mut riding = riding_clear();
+        let settle = RATE.ticks_from_ms(TRIM_SETTLE_MS);
+        assert_eq!(riding.trim_band_rad(RATE, Tick(10), true), None);
+        assert_eq!(riding.trim_band_rad(RATE, Tick(9 + settle), true), None);
+        let band = riding.trim_band_rad(RATE, Tick(10 + settle), true);
+        assert_eq!(band, Some(TRIM_BAND_RAD));
+        // Legs that move again start the wait afresh.
+        let later = 20 + settle;
+        assert_eq!(riding.trim_band_rad(RATE, Tick(later), false), None);
+        assert_eq!(riding.trim_band_rad(RATE, Tick(later + 1), true), None);
+    }
+
+    #[test]
+    fn a_position_error_is_forgiven_only_under_the_slope_rules_and_not_while_reposing() {
+        let mut riding = riding_clear();
+        assert_eq!(riding.forgive_s(false), None);
+        assert_eq!(riding.forgive_s(true), Some(FORGIVE_S));
+        riding.repose = Some(Repose {
+            since: Tick(0),
+            to_clear: false,
+            still_since: None,
+        });
+        assert_eq!(riding.forgive_s(true), None);
+    }
+
+    #[test]
+    fn leaving_the_wheels_folds_the_pose_and_leaving_the_mode_drops_its_watch() {
+        let mut riding = riding_clear();
+        riding.backed_m = 2.0;
+        riding.enter(State::Wheels(WheelMotion::Balance));
+        assert!(riding.clear(), "a stop on the wheels keeps the legs clear");
+        assert_eq!(riding.backed_m, 0.0);
+        riding.enter(State::Legs(crate::control::fsm::LegMotion::Stand));
+        assert!(!riding.clear());
+    }
+}
