@@ -4,6 +4,7 @@ use crate::control::estimator::EstimatorConfig;
 use crate::control::heading::HeadingConfig;
 use crate::control::steering::SteeringConfig;
 use crate::control::stop::StopConfig;
+use crate::control::terrain::rise::RiseConfig;
 use crate::control::terrain::TerrainConfig;
 use crate::legs::blocked::BlockedConfig;
 use crate::legs::climb::ClimbConfig;
@@ -107,6 +108,9 @@ pub struct Config {
     /// Where the rangefinder sits and how its rangings are read
     /// ([`crate::control::terrain`]).
     pub terrain: TerrainConfig,
+    /// When a backward trot sees the ground behind rise
+    /// ([`crate::control::terrain::rise`]).
+    pub rise: RiseConfig,
 }
 
 /// Per-wheel torque limit of the robot, N·m.
@@ -161,6 +165,7 @@ impl Config {
         blocked: BlockedConfig::ROBOT,
         climb: Some(ClimbConfig::ROBOT),
         terrain: TerrainConfig::ROBOT,
+        rise: RiseConfig::ROBOT,
     };
 
     /// This configuration at another control rate (gains are per second, so only the tick

@@ -285,8 +285,9 @@ wire_flags!(
         /// leaned on its legs while the balance law drove the wheels: the wheels held still.
         RUNAWAY = 11 => "runaway",
         /// The trot's leading feet ended their swings behind where they were sent, swing after
-        /// swing (a step or a wall they cannot clear): the robot stopped and stands; cleared by
-        /// the operator's next request.
+        /// swing (a step or a wall they cannot clear), or, walking backward, the rangefinder saw
+        /// the ground behind rise (a riser or a slope ahead of the back feet): the robot stopped
+        /// and stands; cleared by the operator's next request.
         LEG_BLOCKED = 12 => "leg_blocked",
         /// The autonomous mode met a step it does not climb (lower than the wheels roll
         /// over, higher than the legs set a foot on, or no ground within their reach): the

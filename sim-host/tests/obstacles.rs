@@ -1,6 +1,7 @@
 //! A trot into a step it cannot clear (`firmware::legs::blocked`): the robot stops, stands and
-//! reports `leg_blocked`, never falls or marches on against the riser; on flat ground the watch
-//! never stops a trot. Seeded randomized trials: each trial is one of the campaign's robots as
+//! reports `leg_blocked`, never falls or marches on against the riser; walking backward the
+//! rangefinder stops it before a riser it sees coming (`firmware::control::terrain::rise`);
+//! on flat ground the watches never stop a trot. Seeded randomized trials: each trial is one of the campaign's robots as
 //! built (`campaign::draw`, drives rated), a riser height and an approach distance.
 //!
 //! `cargo test --release -p sim-host --test obstacles -- --nocapture` prints the figures.
@@ -51,6 +52,8 @@ struct Figures {
     fell: bool,
     /// Whether the report was gone after the operator's STOP.
     cleared: bool,
+    /// How far the leading feet stood from the riser when the report came, m.
+    gap_m: f64,
 }
 
 /// Stand, then L toward a `height_m` step whose riser is `approach_m` ahead of the front feet
@@ -104,6 +107,12 @@ fn trot_into_step(seed: u64, height_m: f64, approach_m: f64, backward: bool) -> 
         let reported = record.faults.contains(FaultFlags::LEG_BLOCKED);
         if reported && f.blocked.is_none() {
             f.blocked = Some((t, record.state));
+            let x = rig.sim().physics().torso().pos_m[0];
+            f.gap_m = if backward {
+                x - FEET_BEHIND_M - (riser_x_m + DEPTH_M)
+            } else {
+                riser_x_m - x - FEET_AHEAD_M
+            };
         }
         if f.blocked.is_some() && t < STOP_AT_S {
             let x = rig.sim().physics().torso().pos_m[0];
@@ -174,6 +183,29 @@ fn a_backward_trot_into_a_riser_mostly_stops_before_it_falls() {
         println!("MEASURED K into {height_m} m: stopped {stopped} of {TRIALS}, fell {fell}");
         assert!(stopped >= least, "{height_m} m: {others:#?}");
     }
+}
+
+/// Walking backward the rangefinder watches the ground behind
+/// (`firmware::control::terrain::rise`): a riser the trot meets from farther than the beam's
+/// spot (0.6 m behind the back feet) stops it before its feet touch the step, so none lands
+/// on the riser's edge. Robots 0–15, a 5–7 cm riser 1–2 m behind the back feet.
+#[test]
+fn a_backward_trot_stops_before_a_riser_the_rangefinder_sees() {
+    let mut gaps_m = Vec::new();
+    for seed in 0..16 {
+        let mut draw = Draw::new(seed ^ 0x0b57_ac1e);
+        let approach_m = 1.0 + 0.6 * draw.unit();
+        let height_m = 0.06 + 0.02 * (draw.unit() - 0.5);
+        let f = trot_into_step(seed, height_m, approach_m, true);
+        println!("MEASURED K toward {height_m:.3} m, {approach_m:.2} m behind: {f:?}");
+        let (stopped_s, state) = f.blocked.unwrap_or_else(|| panic!("never stopped: {f:?}"));
+        assert_eq!(state, Some(State::Legs(LegMotion::Stand)), "{f:?}");
+        assert!(f.contact_s.is_none(), "touched the step: {f:?}");
+        assert!(!f.fell && f.max_tilt_deg < 20.0, "{f:?}");
+        assert!(f.after_m < 0.2 && f.cleared, "{f:?}");
+        gaps_m.push((seed, stopped_s, f.gap_m));
+    }
+    println!("MEASURED K toward a riser seen behind: (seed, stopped at s, back feet to riser m) {gaps_m:.2?}");
 }
 
 #[test]

@@ -275,6 +275,7 @@ impl Controller {
         }
         let dt_s = self.config.rate.period_s();
         let ranging = self.sensors.take_range();
+        self.watch_behind(ranging);
         if self.state == State::Wheels(WheelMotion::Auto) {
             self.ride_step(now, dt_s, ranging);
         }

@@ -296,5 +296,6 @@ impl TerrainWatch {
     }
 }
 
+pub mod rise;
 #[cfg(test)]
 mod tests;

@@ -14,6 +14,7 @@ use crate::legs::kinematics::{leg_fk, LegJoints};
 use crate::time::Tick;
 
 use super::riding::Riding;
+use crate::control::terrain::rise::RiseWatch;
 
 /// What the autonomous mode keeps of its climbs and of the ground it rides.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -36,6 +37,8 @@ pub(super) struct Autonomy {
     pub(super) range_lost: bool,
     /// The legs' pose for the ground behind (see [`Riding`]).
     pub(super) riding: Riding,
+    /// What a backward trot sees behind (see [`RiseWatch`]).
+    pub(super) behind: RiseWatch,
 }
 
 impl Controller {
