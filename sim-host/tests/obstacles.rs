@@ -73,7 +73,12 @@ fn trot_into_step(seed: u64, height_m: f64, approach_m: f64, backward: bool) -> 
         depth_m: DEPTH_M,
         behind: false,
     });
-    let path = scene_file(&scene, &format!("seed-{seed}-{backward}"));
+    // One file per scene: the tests run in parallel, and two trials of one seed with
+    // different steps read each other's scene.
+    let path = scene_file(
+        &scene,
+        &format!("seed-{seed}-{backward}-{height_m:.4}-{approach_m:.4}"),
+    );
     let (mode, start_s) = if backward {
         // As the campaign's K: stood up first.
         (TeleopMode::TrotBackward, 2.0)
