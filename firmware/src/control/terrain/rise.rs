@@ -32,6 +32,13 @@ pub const HISTORY: usize = 16;
 /// Rangings between two kept averages: with [`HISTORY`], the last 3.2 s.
 pub const HISTORY_EVERY: usize = 10;
 
+/// Rangings before the watch judges: the settling and one full window.
+const READY: usize = SETTLE_RANGINGS + RISE_WINDOW;
+
+/// A whole number of windows and of the history's turns, 16 s: past [`READY`] the count
+/// wraps by it, so that a trot of any length keeps every index it gives running unbroken.
+const COUNT_PERIOD: usize = 800;
+
 /// Tunables of the watch.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RiseConfig {
@@ -102,7 +109,10 @@ impl RiseWatch {
             *slot = height_m;
         }
         self.count = self.count.saturating_add(1);
-        if self.count < RISE_WINDOW + SETTLE_RANGINGS {
+        if self.count >= READY + COUNT_PERIOD {
+            self.count -= COUNT_PERIOD;
+        }
+        if self.count < READY {
             return false;
         }
         let average_m = self.heights_m.iter().sum::<f32>() / RISE_WINDOW as f32;
@@ -168,6 +178,19 @@ mod tests {
             .enumerate()
             .map(|(i, h)| h + 0.0002 * i as f32);
         assert!(drifting.into_iter().all(|h| !watch.update(&CONFIG, h)));
+    }
+
+    #[test]
+    fn the_count_wraps_by_whole_windows_and_history_turns() {
+        assert_eq!(COUNT_PERIOD % RISE_WINDOW, 0);
+        assert_eq!(COUNT_PERIOD % (HISTORY * HISTORY_EVERY), 0);
+        let mut watch = RiseWatch::default();
+        // Ten minutes of trot on flat ground, then a riser: seen as on the first minute.
+        assert!(bobbing(30_000, 0.0).all(|h| !watch.update(&CONFIG, h)));
+        assert!(watch.count < READY + COUNT_PERIOD);
+        let rose_after = bobbing(200, 0.05).position(|h| watch.update(&CONFIG, h));
+        let within = RISE_WINDOW + RISEN_RANGINGS;
+        assert!(rose_after.is_some_and(|n| n <= within), "{rose_after:?}");
     }
 
     #[test]
