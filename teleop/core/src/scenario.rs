@@ -450,7 +450,7 @@ mod tests {
     #[test]
     fn errors_name_the_line() {
         let cases = [
-            ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"Q\"\n", 4, "use W S A L K X, stand, fold, drive, walk or auto"),
+            ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"Q\"\n", 4, MODE_NAMES),
             ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"W\"\n[[step]]\nat_s = 0\nmode = \"X\"\n", 6, "not after"),
             ("duration_s = 6\n[[step]]\nat_s = 0\nmode = \"W\"\nbody_height_m = 0.3\n", 5, "−0.10…+0.12"),
             ("duration_s = 6\n[[step]]\nat_s = 9\nmode = \"W\"\n", 3, "duration_s"),

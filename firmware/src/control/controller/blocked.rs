@@ -6,7 +6,7 @@
 use protocol::Leg;
 
 use super::Controller;
-use crate::control::fsm::{Direction, Event};
+use crate::control::fsm::{Direction, Event, LegMotion, State};
 use crate::legs::blocked::lag_m;
 use crate::legs::kinematics::{leg_fk, LegJoints};
 
@@ -61,11 +61,21 @@ impl Controller {
     /// (`None`: none): ground that rises ahead of the back feet stops the trot as a blocked
     /// foot does ([`Event::LegBlocked`], reported as `leg_blocked`). A trot's feet that land
     /// on a riser's edge tip it (a pair of feet 6 cm apart in height), so the trot stops
-    /// before they reach it. Any other motion forgets what the watch learned.
+    /// before they reach it. A walk that does not stride (`Walk` at no speed) is not
+    /// watched. Any other motion forgets what the watch saw, but the stand that a rise caused:
+    /// walked back again, the robot stops again at once
+    /// ([`crate::control::terrain::rise::RiseWatch::latched`]). A rangefinder that sends
+    /// nothing leaves the watch blind, unreported: the feet's watch remains.
     #[inline(never)] // Once in five ticks: its frame stays off the others.
     pub(super) fn watch_behind(&mut self, ranging: Option<Option<f32>>) {
-        if !matches!(self.trot_motion(), Some((Direction::Backward, _))) {
-            if !self.auto.behind.fresh() {
+        let striding_back = matches!(
+            self.trot_motion(),
+            Some((Direction::Backward, command)) if command.stride_share > 0.0
+        );
+        if !striding_back {
+            let standing_at_it =
+                self.auto.behind.latched() && self.state == State::Legs(LegMotion::Stand);
+            if !self.auto.behind.fresh() && !standing_at_it {
                 self.auto.behind.reset();
             }
             return;
@@ -75,7 +85,6 @@ impl Controller {
         };
         let height_m = self.ground_behind_m(distance_m);
         if self.auto.behind.update(&self.config.rise, height_m) {
-            self.auto.behind.reset();
             self.leg_blocked = true;
             self.apply(Event::LegBlocked);
         }
@@ -84,7 +93,7 @@ impl Controller {
     /// How high a ranging of `distance_m` puts the ground behind the robot over the ground its
     /// feet stand on, m: the spot's height over the line through the lowest front and the
     /// lowest back foot, all in the torso's frame from the drives' encoders. The estimated
-    /// pitch is not used: in a trot it drifted by up to 9° in 5 s on some robots (robot 60),
+    /// pitch is not used: in a trot it drifted by up to 10° in 8 s on some robots (robot 60),
     /// 15 cm of the spot's height; the feet give the body's attitude over the ground they
     /// stand on to the encoders' millimetres.
     fn ground_behind_m(&self, distance_m: f32) -> f32 {

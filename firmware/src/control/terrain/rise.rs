@@ -32,6 +32,9 @@ pub const HISTORY: usize = 16;
 /// Rangings between two kept averages: with [`HISTORY`], the last 3.2 s.
 pub const HISTORY_EVERY: usize = 10;
 
+/// Heights are clamped to this either way, m: a riser the trot cannot take is 5–30 cm.
+const HEIGHT_LIMIT_M: f32 = 0.3;
+
 /// Rangings before the watch judges: the settling and one full window.
 const READY: usize = SETTLE_RANGINGS + RISE_WINDOW;
 
@@ -66,6 +69,9 @@ pub struct RiseWatch {
     count: usize,
     /// Rangings in a row that have read the ground risen.
     risen: usize,
+    /// Whether the ground has risen since the last reset: what the watch saw is kept while
+    /// the robot stands (see [`RiseWatch::latched`]).
+    latched: bool,
 }
 
 impl Default for RiseWatch {
@@ -75,6 +81,7 @@ impl Default for RiseWatch {
             averages_m: [f32::INFINITY; HISTORY],
             count: 0,
             risen: 0,
+            latched: false,
         }
     }
 }
@@ -91,6 +98,15 @@ impl RiseWatch {
         self.averages_m.fill(f32::INFINITY);
         self.count = 0;
         self.risen = 0;
+        self.latched = false;
+    }
+
+    /// Whether the ground has risen since the last reset. The controller keeps such a watch
+    /// through the stop it caused: walked back again, the robot still has the riser behind it
+    /// and stops again at its next ranging, instead of walking its feet onto the riser while
+    /// a fresh watch settles.
+    pub fn latched(&self) -> bool {
+        self.latched
     }
 
     /// Takes one height of the ground where the spot meets it, m (any fixed origin: the
@@ -105,6 +121,9 @@ impl RiseWatch {
         if !height_m.is_finite() {
             return false;
         }
+        // A stray long or short ranging (the beam past an edge, a foot in it) moves one
+        // stride's average by at most a fiftieth of this.
+        let height_m = crate::math::clamp(height_m, -HEIGHT_LIMIT_M, HEIGHT_LIMIT_M);
         if let Some(slot) = self.heights_m.get_mut(self.count % RISE_WINDOW) {
             *slot = height_m;
         }
@@ -132,6 +151,8 @@ impl RiseWatch {
         } else {
             0
         };
+        // Once risen, the count stays: a latched watch walked on judges at once.
+        self.latched |= self.risen >= RISEN_RANGINGS;
         self.risen >= RISEN_RANGINGS
     }
 }
@@ -144,11 +165,21 @@ mod tests {
 
     const CONFIG: RiseConfig = RiseConfig::ROBOT;
 
-    /// A trot's bob on flat ground: ±4 cm around `base_m`, a cycle of 25 rangings.
+    /// A trot's bob on flat ground: ±4 cm around `base_m` over one stride ([`RISE_WINDOW`]).
     fn bobbing(n: usize, base_m: f32) -> impl Iterator<Item = f32> {
+        swaying(n, base_m, 0.04, RISE_WINDOW)
+    }
+
+    /// `base_m` ± `amplitude_m`, a square wave of `period` rangings.
+    fn swaying(
+        n: usize,
+        base_m: f32,
+        amplitude_m: f32,
+        period: usize,
+    ) -> impl Iterator<Item = f32> {
         (0..n).map(move |i| {
-            let phase = (i % RISE_WINDOW) as f32 / RISE_WINDOW as f32;
-            base_m + if phase < 0.5 { 0.04 } else { -0.04 }
+            let up = (i % period) * 2 < period;
+            base_m + if up { amplitude_m } else { -amplitude_m }
         })
     }
 
@@ -157,6 +188,26 @@ mod tests {
         let mut watch = RiseWatch::default();
         // The level is what the robot sees, however far from zero.
         assert!(bobbing(2_000, 0.07).all(|h| !watch.update(&CONFIG, h)));
+    }
+
+    #[test]
+    fn a_sway_over_two_strides_rises_only_if_it_lasts() {
+        // ±2 cm over two strides: the averages swing by nearly 4 cm, past the threshold, but
+        // never for a whole second.
+        let mut watch = RiseWatch::default();
+        assert!(swaying(3_000, 0.0, 0.02, 2 * RISE_WINDOW).all(|h| !watch.update(&CONFIG, h)));
+        // Over four strides the same sway stays up long enough, and counts.
+        let mut watch = RiseWatch::default();
+        assert!(swaying(3_000, 0.0, 0.03, 8 * RISE_WINDOW).any(|h| watch.update(&CONFIG, h)));
+    }
+
+    #[test]
+    fn a_riser_met_while_the_trot_settles_is_its_level() {
+        // The spot climbs a riser 1.5 s into the settling: the watch starts on the
+        // plateau, and the plateau does not rise (without the settling it would).
+        let mut watch = RiseWatch::default();
+        let riser = bobbing(75, 0.0).chain(bobbing(2_000, 0.1));
+        assert!(riser.into_iter().all(|h| !watch.update(&CONFIG, h)));
     }
 
     #[test]
@@ -171,13 +222,13 @@ mod tests {
     }
 
     #[test]
-    fn a_slow_drift_is_no_rise_however_far_it_goes() {
+    fn a_slow_rise_is_no_riser_however_far_it_goes() {
         let mut watch = RiseWatch::default();
-        // 1 cm a second, as the estimated pitch may drift in a trot: 20 cm in 20 s.
-        let drifting = bobbing(1_000, 0.0)
+        // 0.8 cm a second (the spot on a 5° slope at the trot's 0.1 m/s): 16 cm in 20 s.
+        let rising = bobbing(1_000, 0.0)
             .enumerate()
-            .map(|(i, h)| h + 0.0002 * i as f32);
-        assert!(drifting.into_iter().all(|h| !watch.update(&CONFIG, h)));
+            .map(|(i, h)| h + 0.00016 * i as f32);
+        assert!(rising.into_iter().all(|h| !watch.update(&CONFIG, h)));
     }
 
     #[test]
@@ -194,16 +245,33 @@ mod tests {
     }
 
     #[test]
-    fn a_non_finite_height_is_skipped_and_a_reset_forgets_the_level() {
+    fn a_non_finite_height_is_skipped_and_a_reset_forgets_what_was_seen() {
         let mut watch = RiseWatch::default();
         assert!(!watch.update(&CONFIG, f32::NAN));
         assert!(watch.fresh());
-        for h in bobbing(100, 0.0) {
+        for h in bobbing(2 * READY, 0.0) {
+            assert!(!watch.update(&CONFIG, h));
+        }
+        // Without a reset, ground 10 cm higher rises and latches.
+        let mut kept = watch;
+        assert!(bobbing(READY, 0.1).any(|h| kept.update(&CONFIG, h)));
+        assert!(kept.latched());
+        // After one, it is where the robot now is: no rise.
+        watch.reset();
+        assert!(watch.fresh() && !watch.latched());
+        assert!(bobbing(2 * READY, 0.1).all(|h| !watch.update(&CONFIG, h)));
+    }
+
+    #[test]
+    fn a_latched_watch_walked_on_rises_again_at_once() {
+        let mut watch = RiseWatch::default();
+        for h in bobbing(2 * READY, 0.0) {
             watch.update(&CONFIG, h);
         }
-        watch.reset();
-        assert!(watch.fresh());
-        // Heights compared anew: ground 20 cm higher where the robot now is is no rise.
-        assert!(bobbing(100, 0.2).all(|h| !watch.update(&CONFIG, h)));
+        let rose_after = bobbing(READY, 0.06).position(|h| watch.update(&CONFIG, h));
+        assert!(rose_after.is_some() && watch.latched());
+        // Walked back on toward the riser: the same heights, still risen.
+        let again = bobbing(READY, 0.06).position(|h| watch.update(&CONFIG, h));
+        assert_eq!(again, Some(0));
     }
 }
