@@ -1,8 +1,9 @@
 //! A trot into a step it cannot clear (`firmware::legs::blocked`): the robot stops, stands and
 //! reports `leg_blocked`, never falls or marches on against the riser; walking backward the
 //! rangefinder stops it before a riser it sees coming (`firmware::control::terrain::rise`);
-//! on flat ground the watches never stop a trot. Seeded randomized trials: each trial is one of the campaign's robots as
-//! built (`campaign::draw`, drives rated), a riser height and an approach distance.
+//! on flat ground the watches never stop a trot. Seeded randomized trials: each trial is one
+//! of the campaign's robots as built (`campaign::draw`, drives rated), a riser height and an
+//! approach distance.
 //!
 //! `cargo test --release -p sim-host --test obstacles -- --nocapture` prints the figures.
 

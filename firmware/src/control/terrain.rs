@@ -67,6 +67,16 @@ pub struct TerrainConfig {
 }
 
 impl TerrainConfig {
+    /// Where a ranging of `distance_m` puts the beam's spot in the torso's frame, relative to
+    /// the wheel axle, m: (x forward, z up).
+    pub fn spot_on_torso_m(&self, distance_m: f32) -> (f32, f32) {
+        let (sin_d, cos_d) = crate::math::sin_cos(self.depression_rad);
+        (
+            self.mount_x_m - distance_m * cos_d,
+            self.mount_z_m - distance_m * sin_d,
+        )
+    }
+
     /// The robot's VL53L1X on the rear face of the torso, 0.30 m behind and 0.09 m above the
     /// axle, 25° down (the beam meets level ground 0.7–0.9 m behind the axle on the wheels). A
     /// 10° slope rises 2.5 cm while the spot moves 14 cm; a riser's face rises with the spot
@@ -173,10 +183,7 @@ impl TerrainWatch {
     /// The ground's height over the wheels' contact where the beam meets it, m, and how far
     /// behind the axle that is, m.
     pub fn spot_m(config: &TerrainConfig, distance_m: f32, pitch_rad: f32) -> (f32, f32) {
-        let (sin_d, cos_d) = crate::math::sin_cos(config.depression_rad);
-        // The spot in the torso's frame, relative to the axle: x forward, z up.
-        let x = config.mount_x_m - distance_m * cos_d;
-        let z = config.mount_z_m - distance_m * sin_d;
+        let (x, z) = config.spot_on_torso_m(distance_m);
         // Rotated into the level frame by the pitch (+ nose down: the front goes down).
         let (sin_p, cos_p) = crate::math::sin_cos(pitch_rad);
         let level_x = x * cos_p + z * sin_p;

@@ -68,6 +68,10 @@ impl Controller {
     /// nothing leaves the watch blind, unreported: the feet's watch remains.
     #[inline(never)] // Once in five ticks: its frame stays off the others.
     pub(super) fn watch_behind(&mut self, ranging: Option<Option<f32>>) {
+        // Nothing to take and nothing to forget: most ticks off a backward trot.
+        if ranging.is_none() && self.auto.behind.fresh() {
+            return;
+        }
         let striding_back = matches!(
             self.trot_motion(),
             Some((Direction::Backward, command)) if command.stride_share > 0.0
@@ -115,13 +119,9 @@ impl Controller {
             return f32::NAN;
         };
         // The hips' plane is the torso's origin; the axle lies the wheels' mount below it.
-        let terrain = &config.terrain;
-        let axle_z_m = terrain.wheel_radius_m - config.support.wheel_contact_height_m;
-        let (sin_d, cos_d) = crate::math::sin_cos(terrain.depression_rad);
-        let spot = (
-            terrain.mount_x_m - distance_m * cos_d,
-            axle_z_m + terrain.mount_z_m - distance_m * sin_d,
-        );
+        let axle_z_m = config.terrain.wheel_radius_m - config.support.wheel_contact_height_m;
+        let (spot_x_m, spot_z_m) = config.terrain.spot_on_torso_m(distance_m);
+        let spot = (spot_x_m, axle_z_m + spot_z_m);
         let (dx, dz) = (front.0 - back.0, front.1 - back.1);
         let length_m = crate::math::sqrt(dx * dx + dz * dz);
         (dx * (spot.1 - back.1) - dz * (spot.0 - back.0)) / length_m
