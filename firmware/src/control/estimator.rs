@@ -60,6 +60,16 @@
 //! fast against the turn, so the estimate stays where the accelerometer puts it, error and
 //! all, as the trim expects.
 //!
+//! # Striding
+//!
+//! A trot bounces the torso at its step rate: read sample by sample, `|g|` sits outside the
+//! trust band most of a stride, and the estimate coasts on the gyro (its pitch 10.5° off the
+//! truth after 10 s of `K` on some of the campaign's robots). While the legs stride
+//! ([`Motion::striding`]) gravity is therefore low-passed over
+//! [`EstimatorConfig::stride_filter_s`], a stride: the bounce averages out, and what remains
+//! points along gravity as long as the torso, on average, does not accelerate. The turn test
+//! reads the rate low-passed alike, so the stride's rocking does not count as turning.
+//!
 //! # Start-up
 //!
 //! The first sample that feels about 1 g and shows no fast turn sets `v` from the
@@ -103,6 +113,9 @@ pub struct Motion {
     pub on_wheels: bool,
     /// The axle's acceleration along the ground, forward, m/s² (from the wheels' speed).
     pub ground_accel_m_s2: f32,
+    /// The legs stride in a periodic gait: the torso bounces and rocks about a steady
+    /// attitude, so the accelerometer is read as its average over a stride.
+    pub striding: bool,
 }
 
 /// The running filter.
@@ -125,6 +138,9 @@ pub struct AttitudeEstimator {
     start_ticks: u32,
     /// The specific force with the torso's own acceleration taken out, low-passed, m/s².
     gravity: [f32; 3],
+    /// The rate low-passed over a stride while the legs stride, rad/s: how far the torso
+    /// turns, its stride's rocking averaged out.
+    stride_rate_rad_s: [f32; 3],
     /// The specific force the accelerometer reads at rest, m/s²: g until a still window
     /// measures it (a chip's offsets move it by up to a few per cent).
     rest_m_s2: f32,
@@ -151,6 +167,7 @@ impl AttitudeEstimator {
             start_ticks: rate.ticks_from_ms(config.start_ms),
             rest_m_s2: GRAVITY_M_S2,
             gravity: [0.0, 0.0, GRAVITY_M_S2],
+            stride_rate_rad_s: [0.0; 3],
             last: Tick(0),
             attitude: Attitude::default(),
             rate_rad_s: [0.0; 3],
@@ -253,7 +270,12 @@ impl AttitudeEstimator {
         motion: Motion,
     ) -> [f32; 3] {
         let own = self.own_acceleration(config, up, rate, dt_s, motion);
-        let k = (dt_s / config.accel_filter_s).min(1.0);
+        let filter_s = if motion.striding {
+            config.stride_filter_s
+        } else {
+            config.accel_filter_s
+        };
+        let k = (dt_s / filter_s).min(1.0);
         let gravity = zip3(
             self.gravity,
             zip3(accel_m_s2, own, |a, o| a - o),
@@ -268,7 +290,14 @@ impl AttitudeEstimator {
         } else {
             rate
         };
-        let turn = turn_weight(config, turning);
+        // A stride's rocking turns the torso back and forth about where it stays: only a turn
+        // that lasts over a stride counts.
+        self.stride_rate_rad_s = if motion.striding {
+            zip3(self.stride_rate_rad_s, turning, |lp, x| lp + k * (x - lp))
+        } else {
+            turning
+        };
+        let turn = turn_weight(config, self.stride_rate_rad_s);
         self.track_rest(config, dot(gravity, up), dt_s, turn >= 1.0);
         let weight = self.accel_weight(config, norm) * turn;
         if weight > 0.0 {

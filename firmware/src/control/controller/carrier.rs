@@ -41,7 +41,13 @@ impl Controller {
     pub(super) fn motion(&mut self) -> Motion {
         if !(self.balancing() && self.wheels_may_drive()) {
             self.last_ground_m_s = None;
-            return Motion::default();
+            let striding = self
+                .trot_motion()
+                .is_some_and(|(_, command)| command.stride_share > 0.0);
+            return Motion {
+                striding,
+                ..Motion::default()
+            };
         }
         let ground_m_s = self.ground_speed_m_s();
         let hz = self.config.rate.hz() as f32;
@@ -52,6 +58,7 @@ impl Controller {
         Motion {
             on_wheels: true,
             ground_accel_m_s2: if accel.is_finite() { accel } else { 0.0 },
+            striding: false,
         }
     }
 
