@@ -152,53 +152,56 @@ fn trot_into_step(
     f
 }
 
-/// Seeded trials of a trot into a riser `height_m` ± 1 cm high, 0.2–0.6 m away (the issue's
-/// approach); how many stopped with `leg_blocked`, and the figures of those that did not.
-fn trials(trials: u64, height_m: f64, backward: bool) -> (u64, Vec<Figures>) {
-    let mut stopped = 0;
-    let mut others = Vec::new();
-    for seed in 0..trials {
-        let mut draw = Draw::new(seed ^ 0x0b57_ac1e);
-        let approach_m = 0.2 + 0.4 * draw.unit();
-        let height_m = height_m + 0.02 * (draw.unit() - 0.5);
-        let f = trot_into_step(seed, height_m, approach_m, backward, false);
-        println!(
-            "MEASURED {} seed {}, {:.3} m step {:.2} m away: {f:?}",
-            if backward { "K" } else { "L" },
-            f.seed,
-            f.height_m,
-            f.approach_m
-        );
-        let safe_stop = f.contact_s.is_some()
-            && !f.fell
-            && f.max_tilt_deg < 20.0
-            && f.blocked.is_some_and(|(blocked_s, state)| {
-                f.contact_s
-                    .is_some_and(|contact_s| blocked_s - contact_s < 8.0)
-                    && state == Some(State::Legs(LegMotion::Stand))
-            })
-            && f.after_m < if backward { 0.2 } else { 0.10 }
-            && f.cleared;
-        if safe_stop {
-            stopped += 1;
-        } else {
-            others.push(f);
-        }
-    }
-    (stopped, others)
+/// Whether a trot into a riser ended in a safe stop: it met the step, stood with
+/// `leg_blocked` within 8 s of the touch, never fell nor tilted past 20°, moved less than
+/// `after_m` after the report, and the operator's STOP cleared the report.
+fn safe_stop(f: &Figures, after_m: f64) -> bool {
+    f.contact_s.is_some()
+        && !f.fell
+        && f.max_tilt_deg < 20.0
+        && f.blocked.is_some_and(|(blocked_s, state)| {
+            f.contact_s
+                .is_some_and(|contact_s| blocked_s - contact_s < 8.0)
+                && state == Some(State::Legs(LegMotion::Stand))
+        })
+        && f.after_m < after_m
+        && f.cleared
 }
 
-/// None falls, and nearly all stop cleanly. The miss the rate allows is measured: robot 8,
-/// shoved back by the riser, stood 6 cm behind its planted feet when the report came, and its
-/// torso swayed 12 cm over them (the limit is 10) while its feet stayed where they were. Over
-/// robots 0–47, 47 of 48 stop cleanly and none falls.
+/// Seeded trials of a trot into a riser `height_m` ± 1 cm high, 0.2–0.6 m away (the issue's
+/// approach): the figures of each.
+fn trials(trials: u64, height_m: f64, backward: bool) -> Vec<Figures> {
+    (0..trials)
+        .map(|seed| {
+            let mut draw = Draw::new(seed ^ 0x0b57_ac1e);
+            let approach_m = 0.2 + 0.4 * draw.unit();
+            let height_m = height_m + 0.02 * (draw.unit() - 0.5);
+            let f = trot_into_step(seed, height_m, approach_m, backward, false);
+            println!(
+                "MEASURED {} seed {}, {:.3} m step {:.2} m away: {f:?}",
+                if backward { "K" } else { "L" },
+                f.seed,
+                f.height_m,
+                f.approach_m
+            );
+            f
+        })
+        .collect()
+}
+
+/// Every trot stops safely (its torso within 15 cm after the report); nearly all move less
+/// than 10 cm. The one the rate allows is measured: robot 4, pushed back by the riser, stood
+/// 5 cm short of where it stood before when the report came, and its torso swayed 11 cm over
+/// its planted feet. Over robots 0–47, all 48 stop and 45 stay within 10 cm; none falls.
 #[test]
 fn a_trot_into_a_step_it_cannot_clear_stops_and_says_why() {
     const TRIALS: u64 = 16;
-    let (stopped, others) = trials(TRIALS, 0.10, false);
-    println!("MEASURED L into 10 cm: stopped with leg_blocked {stopped} of {TRIALS}");
-    assert!(others.iter().all(|f| !f.fell), "{others:#?}");
-    assert!(stopped >= TRIALS - 1, "{others:#?}");
+    let figures = trials(TRIALS, 0.10, false);
+    let within = figures.iter().filter(|f| safe_stop(f, 0.10)).count() as u64;
+    println!("MEASURED L into 10 cm: stopped with leg_blocked {within} of {TRIALS}");
+    let unsafe_stops: Vec<&Figures> = figures.iter().filter(|f| !safe_stop(f, 0.15)).collect();
+    assert!(unsafe_stops.is_empty(), "{unsafe_stops:#?}");
+    assert!(within >= TRIALS - 1, "{figures:#?}");
 }
 
 /// Walking backward the back feet are watched as the front feet are forward, with a lower
@@ -211,7 +214,9 @@ fn a_trot_into_a_step_it_cannot_clear_stops_and_says_why() {
 fn a_backward_trot_into_a_riser_mostly_stops_before_it_falls() {
     const TRIALS: u64 = 16;
     for (height_m, least) in [(0.10, 14), (0.06, 12)] {
-        let (stopped, others) = trials(TRIALS, height_m, true);
+        let figures = trials(TRIALS, height_m, true);
+        let stopped = figures.iter().filter(|f| safe_stop(f, 0.2)).count();
+        let others: Vec<&Figures> = figures.iter().filter(|f| !safe_stop(f, 0.2)).collect();
         let fell = others.iter().filter(|f| f.fell).count();
         println!("MEASURED K into {height_m} m: stopped {stopped} of {TRIALS}, fell {fell}");
         assert!(stopped >= least, "{height_m} m: {others:#?}");

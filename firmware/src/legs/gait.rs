@@ -101,6 +101,16 @@ impl TrotCommand {
             yaw_rate_rad_s: 0.0,
         }
     }
+
+    /// Whether the body travels along the trot's direction (a trot at no speed marks time).
+    pub fn advances(&self) -> bool {
+        self.stride_share > 0.0
+    }
+
+    /// Whether the feet lift and stride: travelling, or turning on the spot.
+    pub fn lifts_feet(&self) -> bool {
+        self.advances() || (self.yaw_rate_rad_s.is_finite() && self.yaw_rate_rad_s != 0.0)
+    }
 }
 
 /// One leg's stride in a trot, as shares of the full stride (the foot path's length), in the

@@ -74,7 +74,7 @@ impl Controller {
         }
         let striding_back = matches!(
             self.trot_motion(),
-            Some((Direction::Backward, command)) if command.stride_share > 0.0
+            Some((Direction::Backward, command)) if command.advances()
         );
         if !striding_back {
             let standing_at_it =

@@ -37,13 +37,14 @@ impl Controller {
 
     /// What the attitude estimator should know of the torso's own acceleration this tick: on
     /// the wheels while the balance law drives them, the change of the ground speed
-    /// `r (ω + θ̇)` over the tick. Run first in the tick; on the legs it costs no kinematics.
+    /// `r (ω + θ̇)` over the tick; on the legs, whether their feet stride (the torso bounces
+    /// at the step rate). Run first in the tick; on the legs it costs no kinematics.
     pub(super) fn motion(&mut self) -> Motion {
         if !(self.balancing() && self.wheels_may_drive()) {
             self.last_ground_m_s = None;
             let striding = self
                 .trot_motion()
-                .is_some_and(|(_, command)| command.stride_share > 0.0);
+                .is_some_and(|(_, command)| command.lifts_feet());
             return Motion {
                 striding,
                 ..Motion::default()

@@ -65,7 +65,7 @@ impl Controller {
             .trot_yaw_rad_s(self.teleop.yaw_rate_rad_s);
         let striding = self
             .trot_motion()
-            .is_some_and(|(_, command)| command.stride_share > 0.0);
+            .is_some_and(|(_, command)| command.advances());
         let held = striding && self.sensors.estimator().calibrated();
         let [_, _, measured_rad_s] = self.sensors.angular_rate_rad_s;
         let (hold, yaw_rate_rad_s) = &mut self.heading;

@@ -53,9 +53,9 @@ pub struct EstimatorConfig {
     /// twentieth of the crossover's: the wheels' speed and the IMU's reading do not line up
     /// sample by sample, and their difference's jitter would fail the `|a|` test).
     pub accel_filter_s: f32,
-    /// The same while the legs stride, s: a stride of the 1 Hz trot. Read sample by sample,
-    /// the trot's bounce left the accelerometer outside the trust band most of the time, and
-    /// the estimate drifted on the gyro by up to 10.5° in 10 s of `K`.
+    /// The same while the legs stride, s: a stride of the trot at its nominal 1 Hz. Read
+    /// sample by sample, the trot's bounce left the accelerometer outside the trust band most
+    /// of the time, and the estimate drifted on the gyro by up to 10.5° in 10 s of `K`.
     pub stride_filter_s: f32,
 }
 
