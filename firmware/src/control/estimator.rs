@@ -290,7 +290,7 @@ impl AttitudeEstimator {
         // Averaged over a stride in the body frame, gravity lags a tilt that goes on (a slow
         // topple, a slope) by a stride; the estimate's own "up", averaged alike, lags by as
         // much, so the two are compared like with like. (Turning the average with the gyro
-        // instead drifts it by the gyro's unlearned bias over the stride: measured worse.)
+        // instead would drift it by the gyro's unlearned bias over the stride.)
         self.stride_up = if motion.striding {
             zip3(self.stride_up, up, |lp, x| lp + k * (x - lp))
         } else {
