@@ -329,3 +329,23 @@ fn a_turning_trot_strides_each_foot_along_its_hips_path() {
         }
     }
 }
+
+/// The feet stride when the trot travels or turns on the spot, and stay down marking time.
+#[test]
+fn a_trot_lifts_its_feet_when_it_travels_or_turns() {
+    use firmware::legs::gait::TrotCommand;
+    let still = TrotCommand::straight(0.0);
+    assert!(!still.advances() && !still.lifts_feet());
+    let walking = TrotCommand::straight(0.5);
+    assert!(walking.advances() && walking.lifts_feet());
+    let turning = TrotCommand {
+        yaw_rate_rad_s: 0.3,
+        ..still
+    };
+    assert!(!turning.advances() && turning.lifts_feet());
+    let broken = TrotCommand {
+        yaw_rate_rad_s: f32::NAN,
+        ..still
+    };
+    assert!(!broken.lifts_feet());
+}

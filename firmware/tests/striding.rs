@@ -1,8 +1,9 @@
 //! The controller tells the attitude estimator when the legs stride
 //! (`firmware::control::estimator::Motion::striding`), on an ideal plant whose IMU reports a
-//! trot's bounce and rocking: knocked 10° off by a gyro glitch mid-trot, the estimate comes back while the
-//! robot trots (the accelerometer read over a stride), and stays off while it stands and the
-//! torso bounces and rocks alike (read sample by sample, they leave it untrusted).
+//! trot's bounce and rocking: knocked 10° off by a gyro glitch mid-trot, the estimate comes
+//! back while the robot trots (the accelerometer read over a stride), and stays off while it
+//! stands and the torso bounces and rocks alike (read sample by sample, they leave it
+//! untrusted).
 
 mod common;
 

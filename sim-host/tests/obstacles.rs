@@ -190,9 +190,9 @@ fn trials(trials: u64, height_m: f64, backward: bool) -> Vec<Figures> {
 }
 
 /// Every trot stops safely (its torso within 15 cm after the report); nearly all move less
-/// than 10 cm. The one the rate allows is measured: robot 4, pushed back by the riser, stood
-/// 5 cm short of where it stood before when the report came, and its torso swayed 11 cm over
-/// its planted feet. Over robots 0–47, all 48 stop and 45 stay within 10 cm; none falls.
+/// than 10 cm. The one the rate allows is measured: robot 8, shoved back by the riser, stood
+/// 4 cm short of where it stood before when the report came, and its torso swayed 12 cm over
+/// its planted feet. Over robots 0–47, all 48 stop and 47 stay within 10 cm; none falls.
 #[test]
 fn a_trot_into_a_step_it_cannot_clear_stops_and_says_why() {
     const TRIALS: u64 = 16;
@@ -209,11 +209,11 @@ fn a_trot_into_a_step_it_cannot_clear_stops_and_says_why() {
 /// the robot is the harder case: the back feet land on its edge as often as it stops them,
 /// and a trot on feet a riser apart in height tips over. Before the back feet were watched,
 /// 11 of 16 trots into a 6 cm riser behind fell (seeds 0–15, the riser 0.3 m behind). After
-/// the report a robot shoved by the riser moves up to 0.16 m (forward, under 0.1 m).
+/// the report a robot shoved by the riser moves up to 0.16 m (forward, under 0.15 m).
 #[test]
 fn a_backward_trot_into_a_riser_mostly_stops_before_it_falls() {
     const TRIALS: u64 = 16;
-    for (height_m, least) in [(0.10, 14), (0.06, 12)] {
+    for (height_m, least) in [(0.10, 15), (0.06, 12)] {
         let figures = trials(TRIALS, height_m, true);
         let stopped = figures.iter().filter(|f| safe_stop(f, 0.2)).count();
         let others: Vec<&Figures> = figures.iter().filter(|f| !safe_stop(f, 0.2)).collect();

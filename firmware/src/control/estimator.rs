@@ -68,10 +68,13 @@
 //! ([`Motion::striding`]) gravity is therefore low-passed over
 //! [`EstimatorConfig::stride_filter_s`], a stride: the bounce is cut to about a twelfth, and
 //! what remains points along gravity as long as the torso, on average, does not accelerate.
-//! The estimate's "up" is low-passed alike and the correction compares the two averages, so a
-//! tilt that goes on (a topple, a slope) lags both equally instead of pulling the estimate a
-//! stride behind. The turn test reads the rate low-passed alike, so the stride's rocking does
-//! not count as turning.
+//! The turn test reads the rate low-passed alike, so the stride's rocking does not count as
+//! turning. The price: a tilt that goes on while the legs stride (a slow topple, a slope) is
+//! pulled toward where gravity was a stride ago (8.5° behind after 2 s of a 0.3 rad/s topple,
+//! the gyro carrying the rest). Two cures were measured and set aside: the estimate's "up"
+//! averaged alike and compared with the average put the stride's lag inside the correction
+//! loop (a damping ratio of about 0.3 instead of 1), and the average turned with the gyro
+//! drifts by the gyro's unlearned bias; neither measured better in the campaign.
 //!
 //! # Start-up
 //!
@@ -144,8 +147,6 @@ pub struct AttitudeEstimator {
     /// The rate low-passed over a stride while the legs stride, rad/s: how far the torso
     /// turns, its stride's rocking averaged out.
     stride_rate_rad_s: [f32; 3],
-    /// The estimate's "up" low-passed as `gravity` is while the legs stride (`up` otherwise).
-    stride_up: [f32; 3],
     /// The specific force the accelerometer reads at rest, m/s²: g until a still window
     /// measures it (a chip's offsets move it by up to a few per cent).
     rest_m_s2: f32,
@@ -173,7 +174,6 @@ impl AttitudeEstimator {
             rest_m_s2: GRAVITY_M_S2,
             gravity: [0.0, 0.0, GRAVITY_M_S2],
             stride_rate_rad_s: [0.0; 3],
-            stride_up: [0.0, 0.0, 1.0],
             last: Tick(0),
             attitude: Attitude::default(),
             rate_rad_s: [0.0; 3],
@@ -287,15 +287,6 @@ impl AttitudeEstimator {
             zip3(accel_m_s2, own, |a, o| a - o),
             |lp, x| lp + k * (x - lp),
         );
-        // Averaged over a stride in the body frame, gravity lags a tilt that goes on (a slow
-        // topple, a slope) by a stride; the estimate's own "up", averaged alike, lags by as
-        // much, so the two are compared like with like. (Turning the average with the gyro
-        // instead would drift it by the gyro's unlearned bias over the stride.)
-        self.stride_up = if motion.striding {
-            zip3(self.stride_up, up, |lp, x| lp + k * (x - lp))
-        } else {
-            up
-        };
         self.gravity = gravity;
         let norm = sqrt(dot(gravity, gravity));
         // On the wheels a spin about "up" tilts nothing and its acceleration at the IMU is in
@@ -313,10 +304,10 @@ impl AttitudeEstimator {
             turning
         };
         let turn = turn_weight(config, self.stride_rate_rad_s);
-        self.track_rest(config, dot(gravity, self.stride_up), dt_s, turn >= 1.0);
+        self.track_rest(config, dot(gravity, up), dt_s, turn >= 1.0);
         let weight = self.accel_weight(config, norm) * turn;
         if weight > 0.0 {
-            scale(cross(scale(gravity, 1.0 / norm), self.stride_up), weight)
+            scale(cross(scale(gravity, 1.0 / norm), up), weight)
         } else {
             [0.0; 3]
         }
@@ -390,6 +381,7 @@ impl AttitudeEstimator {
         self.restart_window();
         self.gravity = scale(up, self.rest_m_s2);
         let rate = zip3(gyro_rad_s, self.bias_rad_s, |w, b| w - b);
+        self.stride_rate_rad_s = rate;
         self.finish(now, up, rate);
     }
 

@@ -29,12 +29,13 @@
 //! something else.
 //!
 //! A robot can also settle where its leading feet reach the riser only just: robot 3 of the
-//! tests, against a 10.8 cm step, marked time there for 15 s, each front foot 1.4–2.1 cm
-//! behind on every swing, under the count's threshold. So a foot behind by more than
-//! [`BlockedConfig::held_lag_m`] on [`BlockedConfig::held_swings`] swings in a row stops the
-//! trot too: on flat ground, over 100 robots 20 s each way, no foot was behind by that much
-//! on more than three swings in a row (and three only on robot 94 walking backward, already
-//! rolling over), once on any forward.
+//! tests (with a form of the estimator since set aside), against a 10.8 cm step, marked time
+//! there for 15 s, each front foot 1.4–2.1 cm behind on every swing, under the count's
+//! threshold. So a foot behind by more than [`BlockedConfig::held_lag_m`] on
+//! [`BlockedConfig::held_swings`] swings in a row stops the trot too: on flat ground (robots
+//! 0–99, 20 s each way at full stride, straight), no foot was behind by that much on more than
+//! one forward swing in a row, nor on more than three backward (robot 94, already rolling
+//! over). Not measured at lower speed or turning, where the lag is scaled up.
 //!
 //! Walking backward the back feet lead and are watched the same way, except that a single
 //! swing counts at once from [`BlockedConfig::backward_at_once_m`]. Measured at 70 % of the

@@ -107,7 +107,8 @@ impl TrotCommand {
         self.stride_share > 0.0
     }
 
-    /// Whether the feet lift and stride: travelling, or turning on the spot.
+    /// Whether the feet lift and stride: travelling, or turning on the spot (the Cartesian
+    /// generator; the report's sine gait does not turn).
     pub fn lifts_feet(&self) -> bool {
         self.advances() || (self.yaw_rate_rad_s.is_finite() && self.yaw_rate_rad_s != 0.0)
     }

@@ -22,6 +22,11 @@ impl Controller {
         let Some((direction, command)) = self.trot_motion() else {
             return;
         };
+        if !command.advances() {
+            // A walk come to a halt starts afresh when it walks off again.
+            self.blocked_swings.reset();
+            return;
+        }
         let (leading, sign) = match direction {
             Direction::Forward => ([Leg::Fl, Leg::Fr], 1.0),
             Direction::Backward => ([Leg::Bl, Leg::Br], -1.0),
