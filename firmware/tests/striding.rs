@@ -8,7 +8,7 @@
 mod common;
 
 use common::bench::{ms, Bench};
-use common::{command, Ticks};
+use common::{command, velocity_command, Ticks};
 
 use firmware::control::fsm::{Direction, LegMotion, State};
 use protocol::{Acceleration, AngularRate, AnyMessage, Imu, TeleopMode};
@@ -76,4 +76,27 @@ fn a_trotting_robot_knocked_off_comes_back_a_standing_one_bouncing_does_not() {
         trotting.state(),
         State::Legs(LegMotion::Trot(Direction::Backward))
     );
+}
+
+/// A walk at no speed that turns on the spot lifts its feet: it strides as far as the estimator
+/// is concerned; one that neither travels nor turns marks time with its feet down, and does not.
+#[test]
+fn a_walk_turning_on_the_spot_strides_one_marking_time_does_not() {
+    let mut turning = stood_then(TeleopMode::Stand);
+    turning.send(velocity_command(TeleopMode::Walk, 0.0, 0.5));
+    turning.run(1);
+    assert_eq!(turning.state(), State::Legs(LegMotion::Walk));
+    bouncing(&mut turning, ms(1_000), 0);
+    bouncing(&mut turning, ms(100), ms(100));
+    let turned = bouncing(&mut turning, ms(10_000), 0);
+    let mut marking = stood_then(TeleopMode::Stand);
+    marking.send(velocity_command(TeleopMode::Walk, 0.0, 0.0));
+    marking.run(1);
+    assert_eq!(marking.state(), State::Legs(LegMotion::Walk));
+    bouncing(&mut marking, ms(1_000), 0);
+    bouncing(&mut marking, ms(100), ms(100));
+    let marked = bouncing(&mut marking, ms(10_000), 0);
+    println!("10 s after a 10° glitch: walk turning {turned:.2}°, marking time {marked:.2}°");
+    assert!(turned.abs() < 1.5, "turning: {turned:.2}°");
+    assert!(marked.abs() > 5.0, "marking time: {marked:.2}°");
 }
