@@ -74,8 +74,9 @@ pub struct BlockedConfig {
     pub min_scale: f32,
     /// Walking backward, a back foot this far behind its target stops the trot at once, m.
     /// Against a riser behind, a foot that meets it is 1.5–4.7 cm behind, and a count of two
-    /// came too late for 7 of 16 trots; on flat ground 16 robots' worst was 2.8 cm, and 2 of
-    /// the campaign's 500 `K` runs stop; at 4 cm, 7 of 16 riser trots fell.
+    /// came too late for 7 of 16 trots; on flat ground 16 robots' worst was 2.8 cm, and of the
+    /// campaign's 500 `K` runs 3 stop short (safe aborts) and one is stopped already tipping;
+    /// at 4 cm, 7 of 16 riser trots fell.
     pub backward_at_once_m: f32,
     /// Swings of each leading leg that do not stop the trot at once after the counts start
     /// afresh (a trot starting, or turning back); they count as any other. The start rocks the
@@ -111,20 +112,33 @@ impl BlockedConfig {
 /// Each leg's count of blocked swings, in [`Leg`]'s index order.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct BlockedSwings {
-    counts: [u8; 4],
-    /// Swings measured since the count started, saturating.
-    swings: [u8; 4],
+    legs: [LegSwings; 4],
+}
+
+/// One leading leg's swings since the counts started.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct LegSwings {
+    /// Up one per blocked swing, down one per free swing.
+    count: u8,
+    /// Swings measured, saturating.
+    swings: u8,
     /// Swings in a row behind by more than [`BlockedConfig::held_lag_m`], saturating.
-    held: [u8; 4],
+    held: u8,
+}
+
+impl LegSwings {
+    const NEW: Self = Self {
+        count: 0,
+        swings: 0,
+        held: 0,
+    };
 }
 
 impl BlockedSwings {
     /// Nothing counted.
     pub const fn new() -> Self {
         Self {
-            counts: [0; 4],
-            swings: [0; 4],
-            held: [0; 4],
+            legs: [LegSwings::NEW; 4],
         }
     }
 
@@ -146,38 +160,30 @@ impl BlockedSwings {
             Direction::Forward => config.at_once_m,
             Direction::Backward => config.backward_at_once_m,
         };
-        let (Some(count), Some(swings)) = (
-            self.counts.get_mut(leg as usize),
-            self.swings.get_mut(leg as usize),
-        ) else {
+        let Some(this) = self.legs.get_mut(leg as usize) else {
             return false;
         };
-        *swings = swings.saturating_add(1);
-        let settled = *swings > config.settle_swings;
-        let held = match self.held.get_mut(leg as usize) {
-            Some(held) => {
-                *held = if lag_m > config.held_lag_m {
-                    held.saturating_add(1)
-                } else {
-                    0
-                };
-                config.held_swings > 0 && *held >= config.held_swings
-            }
-            None => false,
+        this.swings = this.swings.saturating_add(1);
+        let settled = this.swings > config.settle_swings;
+        this.held = if lag_m > config.held_lag_m {
+            this.held.saturating_add(1)
+        } else {
+            0
         };
-        *count = if settled && lag_m > at_once_m {
+        this.count = if settled && lag_m > at_once_m {
             config.count
         } else if lag_m > config.lag_m {
-            count.saturating_add(1)
+            this.count.saturating_add(1)
         } else {
-            count.saturating_sub(1)
+            this.count.saturating_sub(1)
         };
-        held || (config.count > 0 && *count >= config.count)
+        (config.held_swings > 0 && this.held >= config.held_swings)
+            || (config.count > 0 && this.count >= config.count)
     }
 
     /// `leg`'s count.
     pub fn count(&self, leg: Leg) -> u8 {
-        self.counts.get(leg as usize).copied().unwrap_or(0)
+        self.legs.get(leg as usize).map_or(0, |this| this.count)
     }
 }
 
@@ -272,7 +278,7 @@ mod tests {
         assert!(!swings.swing_measured(&config, Leg::Fr, far, Direction::Forward));
         assert!(
             swings.swing_measured(&config, Leg::Fr, far, Direction::Forward),
-            "behind twice from the start: the count"
+            "behind twice from the start: stopped on the second swing"
         );
     }
 
