@@ -105,7 +105,7 @@ pub fn run() -> Result<(), String> {
     crate::firmware::run()?;
     crate::pil::run(&[])?;
     steps.done("MCU clippy, image and PIL");
-    // libFuzzer from the committed seeds: a minute per frame target, 20 s per other target
+    // libFuzzer from the committed seeds: 30 s per frame target, 15 s per other target
     // (the long runs are documented).
     crate::fuzz::ci()?;
     steps.done("fuzzing");
