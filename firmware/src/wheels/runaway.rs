@@ -92,6 +92,10 @@ const STALL_STILL_M_S: f32 = 0.02;
 pub struct RunawayInput {
     /// Ground speed of the axle, m/s.
     pub ground_speed_m_s: f32,
+    /// Ground speed of the wheel furthest behind the reference's direction, m/s: the
+    /// collision criterion reads it. A robot that meets a riser at an angle has one wheel
+    /// stopped while the other rolls on, and the axle decelerates half as hard.
+    pub lagging_wheel_m_s: f32,
     /// The balance law's speed reference, m/s.
     pub velocity_ref_m_s: f32,
     /// Total wheel torque the law asks for, N·m.
@@ -146,7 +150,8 @@ pub struct Runaway {
     /// Whether standing still against the reference is given [`PATIENT_FACTOR`] times as long
     /// (see [`Runaway::set_patient`]).
     patient: bool,
-    /// Last tick's speed error, m/s (NaN: none yet), and the filtered rate it changes, m/s².
+    /// Last tick's speed error of the lagging wheel, m/s (NaN: none yet), and the filtered rate
+    /// it changes, m/s².
     last_error_m_s: f32,
     error_rate_m_s2: f32,
     period_s: f32,
@@ -208,8 +213,9 @@ impl Runaway {
     /// too long. A non-finite input counts as out of bounds.
     pub fn update(&mut self, config: &RunawayConfig, input: &RunawayInput) -> Option<FaultFlags> {
         let error = input.ground_speed_m_s - input.velocity_ref_m_s;
-        let rate = (error - self.last_error_m_s) / self.period_s;
-        self.last_error_m_s = error;
+        let lag_error = input.lagging_wheel_m_s - input.velocity_ref_m_s;
+        let rate = (lag_error - self.last_error_m_s) / self.period_s;
+        self.last_error_m_s = lag_error;
         // About 16 ms of smoothing at 250 Hz: a step in the measured speed is not a collision.
         if rate.is_finite() {
             self.error_rate_m_s2 += 0.25 * (rate - self.error_rate_m_s2);
@@ -222,7 +228,7 @@ impl Runaway {
         let direction = input.velocity_ref_m_s.signum();
         let against = input.velocity_ref_m_s.abs() >= config.collision_min_speed_m_s
             && self.error_rate_m_s2 * direction < 0.0
-            && error * direction <= -config.collision_drop_m_s;
+            && lag_error * direction <= -config.collision_drop_m_s;
         let collision = against && beyond(self.error_rate_m_s2.abs(), config.collision_m_s2);
         let [speed_limit, saturation_limit, collision_limit, following_limit, struck_limit, blocked_limit] =
             self.limits_ticks;

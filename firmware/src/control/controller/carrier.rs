@@ -35,6 +35,23 @@ impl Controller {
         r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s)
     }
 
+    /// The ground speed of the wheel furthest behind the balance law's speed reference, m/s
+    /// (the slower one in the reference's direction; the axle's when asked to stand).
+    pub(super) fn lagging_wheel_m_s(&self) -> f32 {
+        let r = self.config.balance.wheel_radius_m;
+        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        let [left, right] = self.sensors.wheel_rate_rad_s;
+        let reference_m_s = self.balance.velocity_ref_m_s();
+        let lagging = if reference_m_s == 0.0 {
+            0.5 * (left + right)
+        } else if (left - right) * reference_m_s < 0.0 {
+            left
+        } else {
+            right
+        };
+        r * (lagging + pitch_rate_rad_s)
+    }
+
     /// What the attitude estimator should know of the torso's own acceleration this tick: on
     /// the wheels while the balance law drives them, the change of the ground speed
     /// `r (ω + θ̇)` over the tick; on the legs, whether their feet stride (the torso bounces

@@ -50,6 +50,7 @@ impl Controller {
         if matches!(self.state, State::Wheels(_)) {
             let input = RunawayInput {
                 ground_speed_m_s: self.ground_speed_m_s(),
+                lagging_wheel_m_s: self.lagging_wheel_m_s(),
                 velocity_ref_m_s: self.balance.velocity_ref_m_s(),
                 // What the law asks for, held for a fall or not: a fall's hold is short, and
                 // a wheel that cannot do what the law asks for longer is what is watched.

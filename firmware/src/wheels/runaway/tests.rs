@@ -13,6 +13,7 @@ fn detector() -> Runaway {
 fn input(speed: f32, reference: f32, torque: f32) -> RunawayInput {
     RunawayInput {
         ground_speed_m_s: speed,
+        lagging_wheel_m_s: speed,
         velocity_ref_m_s: reference,
         torque_nm: torque,
         torque_limit_nm: 60.0,
@@ -45,6 +46,35 @@ fn a_robot_stopped_hard_against_its_commanded_speed_trips_as_a_stall() {
     assert_eq!(cause, FaultFlags::WHEEL_STALL);
     // The filter needs a few ticks to pass 2.5 m/s², then the collision time runs.
     assert!((ticks(24)..=ticks(24) + 4).contains(&tick), "{tick}");
+}
+
+/// Backing at 0.48 m/s into a riser met at an angle: one wheel stops in 0.1 s while the other
+/// rolls on (the axle decelerates at 2.4 m/s², under the collision's 2.5); the tick the
+/// detector trips and why, with the lagging wheel read (`lagging`) or the axle's mean alone.
+fn met_at_an_angle(lagging: bool) -> Option<(u32, FaultFlags)> {
+    let mut runaway = detector();
+    for _ in 0..50 {
+        assert_eq!(runaway.update(&CONFIG, &input(-0.48, -0.48, -10.0)), None);
+    }
+    let mut stopped = -0.48_f32;
+    (1..=100).find_map(|tick| {
+        stopped = f32::min(stopped + 4.8 * 0.004, 0.0);
+        let mean = 0.5 * (stopped - 0.48);
+        let sample = RunawayInput {
+            lagging_wheel_m_s: if lagging { stopped } else { mean },
+            ..input(mean, -0.48, -10.0)
+        };
+        runaway.update(&CONFIG, &sample).map(|cause| (tick, cause))
+    })
+}
+
+#[test]
+fn a_wheel_stopped_by_a_riser_met_at_an_angle_trips_as_a_stall_while_the_other_rolls_on() {
+    let (tick, cause) = met_at_an_angle(true).expect("never tripped");
+    assert_eq!(cause, FaultFlags::WHEEL_STALL);
+    assert!((ticks(24)..=ticks(24) + 4).contains(&tick), "{tick}");
+    // Read by the axle's mean alone, the same meeting has not tripped in 0.4 s.
+    assert_eq!(met_at_an_angle(false), None);
 }
 
 #[test]
