@@ -168,12 +168,13 @@ fn on_robots_as_built_and_at_any_distance_a_step_stops_the_wheels_with_a_stall_f
 
 /// Met at an angle, one wheel reaches the riser first and stops while the other rolls on.
 /// Seeded trials: the campaign's robots as built, the step 1.3–3.0 m ahead, met at 5–15°
-/// either way; each stops as the square-on trials do. (Forward, the folded front shanks meet
-/// the riser with the wheels and the axle stops hard; backing into a riser in the autonomous
+/// either way; each stops within the same acceptance as the square-on trials. This test passes
+/// with the detector reading the axle alone too: forward, the folded front shanks meet the
+/// riser with the wheels and the axle stops hard. (Backing into a riser in the autonomous
 /// mode, it is the lagging wheel the detector reads that starts the climb at once: see
 /// `tests/climb.rs`.)
 #[test]
-fn met_at_an_angle_a_step_stops_the_wheels_with_a_stall_fault_as_fast() {
+fn met_at_an_angle_a_step_stops_the_wheels_with_a_stall_fault() {
     const TRIALS: u64 = 12;
     let mut worst_s = 0.0_f64;
     for seed in 0..TRIALS {

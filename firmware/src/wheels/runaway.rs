@@ -27,15 +27,15 @@ pub struct RunawayConfig {
     pub saturation_fraction: f32,
     /// … for this long trips the detector, ms.
     pub saturation_ms: u32,
-    /// The robot's acceleration this far from the reference's counts as a collision, m/s²
-    /// (the reference changes at most at the brake limit; a wheel against a step stops the
-    /// robot several times faster).
+    /// The lagging wheel's acceleration ([`RunawayInput::lagging_wheel_m_s`]) this far from
+    /// the reference's counts as a collision, m/s² (the reference changes at most at the brake
+    /// limit; a step stops a wheel against it several times faster).
     pub collision_m_s2: f32,
     /// … for this long trips the detector, ms.
     pub collision_ms: u32,
     /// The collision criterion applies while the speed reference is at least this, m/s.
     pub collision_min_speed_m_s: f32,
-    /// … that has fallen behind its reference by at least this, m/s (a wheel against a step
+    /// … on a wheel fallen behind its reference by at least this, m/s (a wheel against a step
     /// loses that within the collision time; a delayed loop's limit cycle swings about the
     /// reference, its decelerations as steep but its speed within a few cm/s of it), …
     pub collision_drop_m_s: f32,
@@ -92,7 +92,7 @@ const STALL_STILL_M_S: f32 = 0.02;
 pub struct RunawayInput {
     /// Ground speed of the axle, m/s.
     pub ground_speed_m_s: f32,
-    /// Ground speed of the wheel furthest behind the reference's direction, m/s: the
+    /// The wheel that lags, told as an axle's speed, m/s ([`lagging_wheel_m_s`]): the
     /// collision criterion reads it. A robot that meets a riser at an angle has one wheel
     /// stopped while the other rolls on, and the axle decelerates half as hard.
     pub lagging_wheel_m_s: f32,
@@ -220,7 +220,7 @@ impl Runaway {
         if rate.is_finite() {
             self.error_rate_m_s2 += 0.25 * (rate - self.error_rate_m_s2);
         }
-        let speed_bad = beyond(error.abs(), config.speed_error_m_s);
+        let speed_bad = beyond(error.abs(), config.speed_error_m_s) || lag_error.is_nan();
         let saturation_nm = config.saturation_fraction * input.torque_limit_nm;
         let saturated = input.torque_nm.is_nan() || input.torque_nm.abs() >= saturation_nm;
         // Only a deceleration against a commanded speed: a robot braking to rest stops hard in
@@ -274,6 +274,29 @@ impl Runaway {
             }
         })
     }
+}
+
+/// The wheel furthest behind its own reference, told as an axle's speed, m/s: `reference_m_s`
+/// plus that wheel's speed error. Each wheel's reference is the axle's plus its share of the
+/// turn (`turn_m_s`: the left wheel's ground speed over the axle's, the right's as much under),
+/// so a turn alone puts neither wheel behind. With no reference, the axle's speed
+/// (`wheels_m_s`' mean); NaN if either wheel's speed is not finite.
+pub fn lagging_wheel_m_s(wheels_m_s: [f32; 2], reference_m_s: f32, turn_m_s: f32) -> f32 {
+    let [left, right] = wheels_m_s;
+    if !(left.is_finite() && right.is_finite()) {
+        return f32::NAN;
+    }
+    if reference_m_s == 0.0 {
+        return 0.5 * (left + right);
+    }
+    let left_error = left - (reference_m_s + turn_m_s);
+    let right_error = right - (reference_m_s - turn_m_s);
+    let behind = if (left_error - right_error) * reference_m_s < 0.0 {
+        left_error
+    } else {
+        right_error
+    };
+    reference_m_s + behind
 }
 
 /// Whether `value` is past `bound`, or NaN (a non-finite input counts as out of bounds).

@@ -10,6 +10,7 @@ use super::Controller;
 use crate::control::estimator::Motion;
 use crate::control::fsm::State;
 use crate::legs::support::LegStance;
+use crate::wheels::runaway::lagging_wheel_m_s;
 
 /// A stand-up waits while the body leans more than this from its balance point, rad.
 const STAND_LEAN_RAD: f32 = 0.08;
@@ -35,21 +36,21 @@ impl Controller {
         r * (self.sensors.mean_wheel_rate_rad_s() + pitch_rate_rad_s)
     }
 
-    /// The ground speed of the wheel furthest behind the balance law's speed reference, m/s
-    /// (the slower one in the reference's direction; the axle's when asked to stand).
+    /// The wheel furthest behind its reference, told as an axle's speed, m/s (see
+    /// [`lagging_wheel_m_s`]): each wheel's ground speed is r (ω + θ̇) with its own rate, its
+    /// reference the balance law's plus its share of the turn reference.
     pub(super) fn lagging_wheel_m_s(&self) -> f32 {
         let r = self.config.balance.wheel_radius_m;
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
-        let [left, right] = self.sensors.wheel_rate_rad_s;
-        let reference_m_s = self.balance.velocity_ref_m_s();
-        let lagging = if reference_m_s == 0.0 {
-            0.5 * (left + right)
-        } else if (left - right) * reference_m_s < 0.0 {
-            left
-        } else {
-            right
-        };
-        r * (lagging + pitch_rate_rad_s)
+        let wheels_m_s = self
+            .sensors
+            .wheel_rate_rad_s
+            .map(|rate_rad_s| r * (rate_rad_s + pitch_rate_rad_s));
+        lagging_wheel_m_s(
+            wheels_m_s,
+            self.balance.velocity_ref_m_s(),
+            r * self.turn_ref_rad_s,
+        )
     }
 
     /// What the attitude estimator should know of the torso's own acceleration this tick: on

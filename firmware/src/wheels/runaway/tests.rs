@@ -68,6 +68,34 @@ fn met_at_an_angle(lagging: bool) -> Option<(u32, FaultFlags)> {
     })
 }
 
+/// Whether `lagging_wheel_m_s(wheels, reference, turn)` is `expected`, to rounding.
+fn lags_at(wheels: [f32; 2], reference: f32, turn: f32, expected: f32) -> bool {
+    (lagging_wheel_m_s(wheels, reference, turn) - expected).abs() < 1e-6
+}
+
+#[test]
+fn the_lagging_wheel_is_the_one_furthest_behind_its_own_reference() {
+    // Forward, the slower wheel; backward, the one slower backward.
+    assert!(lags_at([0.48, 0.2], 0.48, 0.0, 0.2));
+    assert!(lags_at([0.1, 0.3], 0.48, 0.0, 0.1));
+    assert!(lags_at([-0.48, -0.1], -0.48, 0.0, -0.1));
+    assert!(lags_at([-0.2, -0.48], -0.48, 0.0, -0.2));
+    // Turning at speed, each wheel on its own reference: none behind.
+    assert!(lags_at([0.58, 0.38], 0.48, 0.1, 0.48));
+    // The inner wheel of a turn stopped: behind by its own reference's speed.
+    assert!(lags_at([0.58, 0.0], 0.48, 0.1, 0.1));
+    // No reference: the axle's speed, whichever way the wheels turn.
+    assert!(lags_at([0.2, -0.2], 0.0, 0.3, 0.0));
+    assert!(lagging_wheel_m_s([f32::NAN, 0.2], 0.48, 0.0).is_nan());
+    // A non-finite lagging wheel counts as out of bounds, the axle's speed fine.
+    let sample = RunawayInput {
+        lagging_wheel_m_s: f32::NAN,
+        ..input(0.48, 0.48, 10.0)
+    };
+    let (tick, _) = ticks_to_trip(&mut detector(), &sample).expect("never tripped");
+    assert_eq!(tick, ticks(CONFIG.speed_error_ms));
+}
+
 #[test]
 fn a_wheel_stopped_by_a_riser_met_at_an_angle_trips_as_a_stall_while_the_other_rolls_on() {
     let (tick, cause) = met_at_an_angle(true).expect("never tripped");
