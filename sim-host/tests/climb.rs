@@ -45,8 +45,8 @@ struct Approach {
     standing_first: bool,
 }
 
-/// The issue's approach: 0.2–0.6 m, square to the riser. (Its heading of ±15° is measured,
-/// [`higher_steps_a_heading_and_a_fold_from_standing_measured`], not yet in the tested sets.)
+/// The issue's approach: 0.2–0.6 m, square to the riser. (Its heading of ±15° is
+/// [`NEAR_TURNED`], held to less than the issue asks.)
 const NEAR: Approach = Approach {
     gap_m: [0.2, 0.6],
     max_heading_deg: 0.0,
@@ -168,6 +168,17 @@ const REFUSED_TRAVEL_M: f64 = 1.5;
 /// safely and says why: it refuses the step (`STEP_REFUSED`) or stops with a fault flag, one
 /// that stays before the riser ends within [`REFUSED_TRAVEL_M`] of it, and none falls or
 /// drives on.
+/// The issue's 6 cm case met at headings of up to ±15° either way: none falls, and at least
+/// 36 of 50 robots cross up and down (39 do; the issue asks 95 %, not met: robots that bounce
+/// off the riser as the climb begins tip onto their front feet, docs/obstacles.md).
+#[test]
+fn at_a_heading_of_up_to_15deg_most_robots_cross_the_6cm_step_and_none_falls() {
+    const TRIALS: u64 = 50;
+    let (crossings, fell, _) = trials(0.06, TRIALS, 25.0, NEAR_TURNED);
+    assert_eq!(fell, 0);
+    assert!(crossings >= 36, "{crossings} of {TRIALS}");
+}
+
 #[test]
 fn in_the_autonomous_mode_a_10cm_step_is_a_safe_stop_with_a_reason() {
     let unsafe_stops = ten_cm_trials(NEAR);
@@ -244,12 +255,11 @@ fn a_manual_drive_into_the_step_stops_with_a_stall_fault_and_does_not_climb() {
     }
 }
 
-/// Higher steps, the 6 cm step met at a heading, and after a fold from standing still,
-/// measured (`cargo test --release -p sim-host --test climb -- --ignored --nocapture`).
+/// Higher steps and the 6 cm step after a fold from standing still, measured (`cargo test
+/// --release -p sim-host --test climb -- --ignored --nocapture`).
 #[test]
-#[ignore = "measurement: the 8 cm, heading and standing-first figures in docs/obstacles.md"]
-fn higher_steps_a_heading_and_a_fold_from_standing_measured() {
+#[ignore = "measurement: the 8 cm and standing-first figures in docs/obstacles.md"]
+fn higher_steps_and_a_fold_from_standing_measured() {
     trials(0.08, 50, 30.0, NEAR);
-    trials(0.06, 50, 25.0, NEAR_TURNED);
     trials(0.06, 50, 25.0, NEAR_STANDING);
 }
