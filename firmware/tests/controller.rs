@@ -116,7 +116,8 @@ fn trot_from_the_wheels_stands_up_first() {
         bench.state(),
         State::Standing(LegMotion::Trot(firmware::control::fsm::Direction::Forward))
     );
-    bench.run(400);
+    // The roll ahead (1.5 s), then the unfold.
+    bench.run(800);
     assert_eq!(
         bench.state(),
         State::Legs(LegMotion::Trot(firmware::control::fsm::Direction::Forward))

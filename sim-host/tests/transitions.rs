@@ -10,6 +10,8 @@ use std::path::Path;
 use firmware::control::fsm::State;
 use host_can::fault_plan::Faults;
 use protocol::TeleopMode;
+use sim_host::campaign::draw::Draws;
+use sim_host::campaign::Drives;
 use sim_host::faults::rig::Rig;
 use sim_host::robot::model::DEFAULT_MODEL;
 use teleop_core::scripted::PlanStep;
@@ -125,9 +127,52 @@ fn the_fold_right_after_a_trot_happens_in_place() {
 fn standing_up_from_the_wheels_happens_in_place() {
     let before = [(0.0, TeleopMode::Stop), (0.1, TeleopMode::Fold)];
     let f = transition("stand-up from the wheels", &before, TeleopMode::Stand, 6.0);
-    // 14.3 cm and 4.9° from the fold with the back legs behind the hips; from the levelled
-    // fold the legs first go back there (`Levelling::stow`): 11.5 cm, 6.2° (unfolding from the
-    // levelled fold straight away: 13.4 cm and 8.1°, past the tilt goal). The goal of 5 cm is
-    // not met; the bound holds what is reached.
-    assert_in_place(&f, 0.13, 8.0);
+    // The unfolding feet push the robot back; it first rolls ahead by about as much
+    // (`control::controller::stand_up`): 2.2 cm and 5.7° (11.5 cm and 6.2° without).
+    assert_in_place(&f, 0.05, 8.0);
+}
+
+/// The stand-up from the wheels on the campaign's robots as built (rated drives, the IMU part
+/// drawn, delay): how far each moved from the key press, its largest tilt, whether it stood,
+/// stopped with a fault or fell (`cargo test --release -p sim-host --test transitions --
+/// --ignored --nocapture`; docs/firmware.md, "Folding in place").
+#[test]
+#[ignore = "measurement: the stand-up on the campaign's robots in docs/firmware.md"]
+fn stand_ups_on_the_campaign_robots_measured() {
+    let (mut stood, mut within, mut faulted, mut fell) = (0, 0, 0, 0);
+    const ROBOTS: u64 = 30;
+    for seed in 0..ROBOTS {
+        let plan = vec![
+            PlanStep::at(0.0, TeleopMode::Stop),
+            PlanStep::at(0.1, TeleopMode::Fold),
+            PlanStep::at(6.0, TeleopMode::Stand),
+        ];
+        let clean = Faults::default();
+        let plant = Draws::of(seed).plant(Drives::Rated.ratings());
+        let model = Path::new(DEFAULT_MODEL);
+        let mut rig = Rig::with_plant(model, plan, &clean, &clean, plant).unwrap();
+        rig.run_until(6.0).unwrap();
+        let start = rig.sim().physics().torso().pos_m;
+        let (mut max_tilt_deg, mut fallen) = (0.0_f64, false);
+        while rig.time_s() < 14.0 {
+            rig.step().unwrap();
+            let record = rig.records().last().unwrap();
+            max_tilt_deg = max_tilt_deg.max(record.tilt_deg);
+            fallen |= record.fallen();
+        }
+        let end = rig.sim().physics().torso().pos_m;
+        let moved_m = (end[0] - start[0]).hypot(end[1] - start[1]);
+        let state = rig.records().last().unwrap().state;
+        let standing = matches!(state, Some(State::Legs(_)));
+        println!(
+            "MEASURED robot {seed}: moved {moved_m:.3} m, tilt {max_tilt_deg:.1}°, fell {fallen}, ended {state:?}"
+        );
+        stood += u32::from(standing && !fallen);
+        within += u32::from(standing && !fallen && moved_m <= 0.05 && max_tilt_deg <= 8.0);
+        faulted += u32::from(state == Some(State::Fault));
+        fell += u32::from(fallen);
+    }
+    println!(
+        "MEASURED stand-ups on {ROBOTS} robots: {stood} stood ({within} within 5 cm and 8°), {faulted} stopped with a fault, {fell} fell"
+    );
 }

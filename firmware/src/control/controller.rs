@@ -16,6 +16,7 @@ mod carrier;
 mod climbing;
 mod folding;
 mod riding;
+mod stand_up;
 mod status;
 mod stopping;
 mod supervise;
@@ -117,6 +118,8 @@ pub struct Controller {
     /// When the wheels took the running fold and how far ahead it was then, m: its return
     /// (`None` before, or with no fold).
     fold_return: Option<(Tick, f32)>,
+    /// When the running stand-up began rolling the robot ahead (see `stand_up`).
+    stand_preroll: Option<Tick>,
     /// When the running fold's legs were tucked (`None` before, or with no fold).
     fold_done_at: Option<Tick>,
     /// Whether the robot came to balance in place by a stop from a drive or a turn: it then
@@ -178,6 +181,7 @@ impl Controller {
             fold_origin_x_m: None,
             fold_ahead_m: 0.0,
             fold_return: None,
+            stand_preroll: None,
             fold_done_at: None,
             stopped_on_wheels: false,
             last_ground_m_s: None,
@@ -290,7 +294,7 @@ impl Controller {
             }
             State::Fault if self.stop.is_some() => legs_enabled &= self.run_stop(now),
             State::Hold | State::Fault => {}
-            State::Standing(_) if self.unsettled() => {
+            State::Standing(_) if self.unsettled(now) => {
                 // Settle on the wheels first (`unsettled`): legs that unfold under a rolling
                 // robot lift it off its wheels with its momentum in it (driving at 0.48 m/s,
                 // standing up flipped it over). The goal is set, so the transition is not
@@ -346,7 +350,10 @@ impl Controller {
         // A climb holds the wheels from its first tick: balancing, the robot rolled off the
         // riser as the legs moved.
         let climbing = matches!(self.state, State::Climbing(_));
-        if self.stop.is_some_and(|stop| stop.holds_wheels()) || self.folding_on_feet() || climbing {
+        if self.stop.is_some_and(|stop| stop.holds_wheels())
+            || self.folding_on_feet(now)
+            || climbing
+        {
             return self.hold_wheels(dt_s);
         }
         if !(self.balancing() && self.armed && self.wheels_may_drive()) {
@@ -440,6 +447,7 @@ impl Controller {
             self.fold_origin_x_m = None;
             self.fold_ahead_m = 0.0;
             self.fold_return = None;
+            self.stand_preroll = None;
             self.fold_done_at = None;
             self.auto.climbed = false;
         }

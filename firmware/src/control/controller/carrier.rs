@@ -10,6 +10,7 @@ use super::Controller;
 use crate::control::estimator::Motion;
 use crate::control::fsm::State;
 use crate::legs::support::LegStance;
+use crate::time::Tick;
 use crate::wheels::runaway::lagging_wheel_m_s;
 
 /// A stand-up waits while the body leans more than this from its balance point, rad.
@@ -104,12 +105,12 @@ impl Controller {
     /// under that lean land their front feet first and stand the robot up nose-down), or its
     /// legs are not yet at the fold a stand-up starts from
     /// ([`crate::legs::levelling::Levelling::stowed`]).
-    pub(super) fn unsettled(&mut self) -> bool {
+    pub(super) fn unsettled(&mut self, now: Tick) -> bool {
         let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
         let leaning = lean_rad.abs() > STAND_LEAN_RAD || pitch_rate_rad_s.abs() > STAND_STILL_RAD_S;
         let stowing = !self.levelling.stowed();
-        self.rolling() || (self.wheels_may_drive() && (leaning || stowing))
+        self.rolling() || (self.wheels_may_drive() && (leaning || stowing || self.prerolling(now)))
     }
 
     /// On the wheels the balance law always runs; while folding or standing up only once the

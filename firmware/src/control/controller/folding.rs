@@ -125,13 +125,8 @@ impl Controller {
         let Some((since, distance_m)) = self.fold_return else {
             return 0.0;
         };
-        let period_s = FOLD_RETURN_MS as f32 * 1e-3;
         let t_s = now.since(since) as f32 * self.config.rate.period_s();
-        if t_s >= period_s || !distance_m.is_finite() {
-            return 0.0;
-        }
-        let omega = core::f32::consts::PI / period_s;
-        -distance_m * 0.5 * omega * crate::math::sin_cos(omega * t_s).0
+        half_sine_m_s(-distance_m, FOLD_RETURN_MS, t_s)
     }
 
     /// Which of the balance law's trim rules may learn now: from the position error only on
@@ -188,12 +183,12 @@ impl Controller {
     /// ([`Controller::unsettled`]): balancing while the legs swing out under it, the law
     /// answered the shift of their mass with a jolt of the wheels, and the torso pitched 7–9°
     /// on the way up (6.5° now, holding, from the fold it stows to).
-    pub(super) fn folding_on_feet(&mut self) -> bool {
+    pub(super) fn folding_on_feet(&mut self, now: Tick) -> bool {
         if !matches!(self.state, State::Folding(_) | State::Standing(_)) || !self.wheels_may_drive()
         {
             return false;
         }
-        if matches!(self.state, State::Standing(_)) && !self.unsettled() {
+        if matches!(self.state, State::Standing(_)) && !self.unsettled(now) {
             return true;
         }
         let support = self.config.support;
@@ -311,4 +306,15 @@ impl Controller {
         clamp_leg_targets(&self.config.limits, &mut clamped, &fallback);
         clamped
     }
+}
+
+/// The speed at `t_s` of a half-sine of speed over `period_ms` that covers `distance_m`, m/s
+/// (zero outside it, or for a distance that is not finite).
+pub(super) fn half_sine_m_s(distance_m: f32, period_ms: u32, t_s: f32) -> f32 {
+    let period_s = period_ms as f32 * 1e-3;
+    if !(0.0..period_s).contains(&t_s) || !distance_m.is_finite() {
+        return 0.0;
+    }
+    let omega = core::f32::consts::PI / period_s;
+    distance_m * 0.5 * omega * crate::math::sin_cos(omega * t_s).0
 }

@@ -47,7 +47,8 @@ impl Controller {
             dt_s,
         );
         let mut common = common;
-        if matches!(self.state, State::Wheels(_)) {
+        // A stand-up balances until the robot has settled (and rolled ahead): watched alike.
+        if matches!(self.state, State::Wheels(_) | State::Standing(_)) {
             let input = RunawayInput {
                 ground_speed_m_s: self.ground_speed_m_s(),
                 lagging_wheel_m_s: self.lagging_wheel_m_s(),
@@ -131,6 +132,7 @@ impl Controller {
                 (within(self.teleop.speed_m_s, top_m_s), turn(yaw_rad_s))
             }
             State::Folding(_) => (self.fold_return_m_s(now), 0.0),
+            State::Standing(_) => (self.stand_preroll_m_s(now), 0.0),
             _ => (0.0, 0.0),
         }
     }
