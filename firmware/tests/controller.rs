@@ -128,6 +128,45 @@ fn trot_from_the_wheels_stands_up_first() {
     assert!(a.iter().zip(b).any(|(x, y)| (x - y).abs() > 0.02));
 }
 
+/// A stand-up from the wheels rolls the robot ahead once: a change of what follows it (`X`
+/// during the stand-up for a trot) does not roll it again.
+#[test]
+fn a_stand_up_rolls_ahead_once() {
+    let mut bench = Bench::on_the_wheels();
+    bench.send(command(TeleopMode::TrotForward));
+    // Until the roll ahead is over: the reference up past 0.1 m/s and back to zero.
+    let mut peak_m_s = 0.0_f32;
+    for _ in 0..ms(3_000) {
+        bench.tick();
+        let reference_m_s = bench.controller.balance().velocity_ref_m_s();
+        peak_m_s = peak_m_s.max(reference_m_s);
+        if peak_m_s > 0.1 && reference_m_s.abs() < 1e-6 {
+            break;
+        }
+    }
+    assert!(peak_m_s > 0.1, "no roll ahead: {peak_m_s} m/s");
+    assert!(
+        matches!(bench.state(), State::Standing(_)),
+        "{:?}",
+        bench.state()
+    );
+    bench.send(command(TeleopMode::Stop));
+    bench.tick();
+    assert!(
+        matches!(bench.state(), State::Standing(_)),
+        "{:?}",
+        bench.state()
+    );
+    for tick in 0..ms(2_000) {
+        bench.tick();
+        let reference_m_s = bench.controller.balance().velocity_ref_m_s();
+        assert!(
+            reference_m_s.abs() < 1e-6,
+            "tick {tick}: {reference_m_s} m/s"
+        );
+    }
+}
+
 /// A stand-up from the wheels first brings the legs to the fold it starts from, balancing; a
 /// fold asked for meanwhile starts on the wheels, where it has nothing to return: the speed
 /// reference stays at zero (an earlier fold's return must not drive the robot again).

@@ -161,13 +161,9 @@ fn in_the_autonomous_mode_the_robot_crosses_a_6cm_step_up_and_down_and_drives_on
 
 /// How far a robot that did not get onto the plateau may end from where it met the riser, m:
 /// what a fold from its lean against the riser rolls it, and a runaway on its back shanks
-/// until the lean watch stops it ([`firmware::wheels::lean`]; 0.92 m at most, measured).
+/// until the lean watch stops it ([`firmware::wheels::lean`]; 0.91 m at most, measured).
 const REFUSED_TRAVEL_M: f64 = 1.5;
 
-/// The issue's 10 cm case (±1 cm): higher than the climb takes. Every one of 50 robots stops
-/// safely and says why: it refuses the step (`STEP_REFUSED`) or stops with a fault flag, one
-/// that stays before the riser ends within [`REFUSED_TRAVEL_M`] of it, and none falls or
-/// drives on.
 /// The issue's 6 cm case met at headings of up to ±15° either way: none falls, and at least
 /// 36 of 50 robots cross up and down (39 do; the issue asks 95 %, not met: robots that bounce
 /// off the riser as the climb begins tip onto their front feet, docs/obstacles.md).
@@ -179,6 +175,10 @@ fn at_a_heading_of_up_to_15deg_most_robots_cross_the_6cm_step_and_none_falls() {
     assert!(crossings >= 36, "{crossings} of {TRIALS}");
 }
 
+/// The issue's 10 cm case (±1 cm): higher than the climb takes. Every one of 50 robots stops
+/// safely and says why: it refuses the step (`STEP_REFUSED`) or stops with a fault flag, one
+/// that stays before the riser ends within [`REFUSED_TRAVEL_M`] of it, and none falls or
+/// drives on.
 #[test]
 fn in_the_autonomous_mode_a_10cm_step_is_a_safe_stop_with_a_reason() {
     let unsafe_stops = ten_cm_trials(NEAR);

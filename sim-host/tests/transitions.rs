@@ -128,7 +128,7 @@ fn standing_up_from_the_wheels_happens_in_place() {
     let before = [(0.0, TeleopMode::Stop), (0.1, TeleopMode::Fold)];
     let f = transition("stand-up from the wheels", &before, TeleopMode::Stand, 6.0);
     // The unfolding feet push the robot back; it first rolls ahead by about as much
-    // (`control::controller::stand_up`): 2.2 cm and 5.7° (11.5 cm and 6.2° without).
+    // (`control::controller::stand_up`): 2.8 cm and 5.7° (11.5 cm and 6.2° without).
     assert_in_place(&f, 0.05, 8.0);
 }
 
@@ -139,7 +139,9 @@ fn standing_up_from_the_wheels_happens_in_place() {
 #[test]
 #[ignore = "measurement: the stand-up on the campaign's robots in docs/firmware.md"]
 fn stand_ups_on_the_campaign_robots_measured() {
-    let (mut stood, mut within, mut faulted, mut fell) = (0, 0, 0, 0);
+    // Stood (and of those within the issue's 5 cm and 8°), stopped with a fault, still
+    // settling for the stand-up at the end, fell: each robot counts once, a fall first.
+    let (mut stood, mut within, mut faulted, mut settling, mut fell) = (0, 0, 0, 0, 0);
     const ROBOTS: u64 = 30;
     for seed in 0..ROBOTS {
         let plan = vec![
@@ -162,17 +164,25 @@ fn stand_ups_on_the_campaign_robots_measured() {
         }
         let end = rig.sim().physics().torso().pos_m;
         let moved_m = (end[0] - start[0]).hypot(end[1] - start[1]);
-        let state = rig.records().last().unwrap().state;
-        let standing = matches!(state, Some(State::Legs(_)));
+        let record = rig.records().last().unwrap();
+        let state = record.state;
         println!(
-            "MEASURED robot {seed}: moved {moved_m:.3} m, tilt {max_tilt_deg:.1}°, fell {fallen}, ended {state:?}"
+            "MEASURED robot {seed}: moved {moved_m:.3} m, tilt {max_tilt_deg:.1}°, \
+             fell {fallen}, ended {state:?}, faults {:?}",
+            record.faults
         );
-        stood += u32::from(standing && !fallen);
-        within += u32::from(standing && !fallen && moved_m <= 0.05 && max_tilt_deg <= 8.0);
-        faulted += u32::from(state == Some(State::Fault));
-        fell += u32::from(fallen);
+        match state {
+            _ if fallen => fell += 1,
+            Some(State::Legs(_)) => {
+                stood += 1;
+                within += u32::from(moved_m <= 0.05 && max_tilt_deg <= 8.0);
+            }
+            Some(State::Fault) => faulted += 1,
+            _ => settling += 1,
+        }
     }
     println!(
-        "MEASURED stand-ups on {ROBOTS} robots: {stood} stood ({within} within 5 cm and 8°), {faulted} stopped with a fault, {fell} fell"
+        "MEASURED stand-ups on {ROBOTS} robots: {stood} stood ({within} within 5 cm and 8°), \
+         {faulted} stopped with a fault, {settling} still settling, {fell} fell"
     );
 }

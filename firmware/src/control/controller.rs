@@ -48,6 +48,7 @@ use crate::wheels::runaway::Runaway;
 use crate::wheels::traction::Traction;
 use crate::wheels::wheel::SpeedLoop;
 use climbing::Autonomy;
+use stand_up::RollAhead;
 
 /// How fast the turn reference changes, rad/s² of wheel rate: a step to the turn's full
 /// rate asked the turn loop for its whole torque at once, and on low friction the wheels slipped
@@ -118,8 +119,8 @@ pub struct Controller {
     /// When the wheels took the running fold and how far ahead it was then, m: its return
     /// (`None` before, or with no fold).
     fold_return: Option<(Tick, f32)>,
-    /// When the running stand-up began rolling the robot ahead (see `stand_up`).
-    stand_preroll: Option<Tick>,
+    /// Where the running stand-up's roll ahead is (see `stand_up`).
+    stand_roll: RollAhead,
     /// When the running fold's legs were tucked (`None` before, or with no fold).
     fold_done_at: Option<Tick>,
     /// Whether the robot came to balance in place by a stop from a drive or a turn: it then
@@ -181,7 +182,7 @@ impl Controller {
             fold_origin_x_m: None,
             fold_ahead_m: 0.0,
             fold_return: None,
-            stand_preroll: None,
+            stand_roll: RollAhead::Due,
             fold_done_at: None,
             stopped_on_wheels: false,
             last_ground_m_s: None,
@@ -447,21 +448,14 @@ impl Controller {
             self.fold_origin_x_m = None;
             self.fold_ahead_m = 0.0;
             self.fold_return = None;
-            self.stand_preroll = None;
             self.fold_done_at = None;
             self.auto.climbed = false;
         }
+        self.stand_roll_into(next);
         self.climb_flags_into(next);
         let moving_on_wheels = matches!(self.state, State::Wheels(motion) if motion.moving());
         self.stopped_on_wheels = moving_on_wheels && next == State::Wheels(WheelMotion::Balance);
         self.state = next;
-    }
-
-    /// Targets and goal at the measured joint positions: nothing moves, and nothing jumps
-    /// when the drives are (re-)enabled.
-    fn follow_measured(&mut self) {
-        self.legs_rad = self.sensors.joint_position_rad;
-        self.goal_rad = self.legs_rad;
     }
 
     fn leg_goal(&mut self, depth_m: f32) {

@@ -104,13 +104,20 @@ impl Controller {
     /// than [`STAND_STILL_RAD_S`] (a stop's brake leans it forward by up to 13°; legs unfolded
     /// under that lean land their front feet first and stand the robot up nose-down), or its
     /// legs are not yet at the fold a stand-up starts from
-    /// ([`crate::legs::levelling::Levelling::stowed`]).
+    /// ([`crate::legs::levelling::Levelling::stowed`]), or it has its roll ahead to make or
+    /// makes it (`stand_up`).
     pub(super) fn unsettled(&mut self, now: Tick) -> bool {
+        self.rolling()
+            || (self.wheels_may_drive() && (self.leaning_or_stowing() || self.rolling_ahead(now)))
+    }
+
+    /// Whether the body leans or pitches too much for a stand-up, or the legs are not yet
+    /// stowed (see [`Controller::unsettled`]).
+    pub(super) fn leaning_or_stowing(&self) -> bool {
         let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
         let leaning = lean_rad.abs() > STAND_LEAN_RAD || pitch_rate_rad_s.abs() > STAND_STILL_RAD_S;
-        let stowing = !self.levelling.stowed();
-        self.rolling() || (self.wheels_may_drive() && (leaning || stowing || self.prerolling(now)))
+        leaning || !self.levelling.stowed()
     }
 
     /// On the wheels the balance law always runs; while folding or standing up only once the
@@ -140,5 +147,12 @@ impl Controller {
         *self
             .leg_stance
             .get_or_insert_with(|| config.support.stance_of(&config.geometry, joints))
+    }
+
+    /// Targets and goal at the measured joint positions: nothing moves, and nothing jumps
+    /// when the drives are (re-)enabled.
+    pub(super) fn follow_measured(&mut self) {
+        self.legs_rad = self.sensors.joint_position_rad;
+        self.goal_rad = self.legs_rad;
     }
 }

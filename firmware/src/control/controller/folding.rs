@@ -163,6 +163,7 @@ impl Controller {
         self.wheels_since = None;
         self.balance.reset();
         self.lean.reset();
+        self.runaway.reset();
         [-gain * left, -gain * right]
     }
 
@@ -179,7 +180,7 @@ impl Controller {
     /// it: the wheels then hold still (a stool on wheels and feet); the balance law takes over
     /// once a fold's tuck lifts the feet clear. Balancing on wheels and feet, the law read the
     /// lean the feet gave the torso as a fall and drove the robot off its feet into a runaway.
-    /// A stand-up holds the wheels from its first tick once the robot is settled on them
+    /// A stand-up holds the wheels once the robot is settled on them and has rolled ahead
     /// ([`Controller::unsettled`]): balancing while the legs swing out under it, the law
     /// answered the shift of their mass with a jolt of the wheels, and the torso pitched 7–9°
     /// on the way up (6.5° now, holding, from the fold it stows to).

@@ -1,33 +1,90 @@
 //! The stand-up's roll ahead. Unfolded from the wheels, the feet land behind their hips
 //! (within the joint ranges no foot comes closer than 7 cm behind its hip at the depth of the
 //! ground on the wheels) and sweep forward on the ground under the rising robot: they push it
-//! back. So before the legs leave the fold the balance law rolls the robot ahead by about as
-//! much, and the stand-up ends where it began.
+//! back. So once the robot has settled on its wheels for a stand-up, and before its legs leave
+//! the fold, the balance law rolls it ahead by about as much, and the stand-up ends where it
+//! began. Once per stand-up: a change between stand-ups (`L` asked during `stand`) does not
+//! roll it again; and not at all on top of a step the robot has climbed, whose edge lies ahead.
 
 use super::folding::half_sine_m_s;
 use super::Controller;
+use crate::control::fsm::State;
 use crate::time::Tick;
 
-/// How far a stand-up from the wheels rolls the robot ahead first, m.
-const STAND_PREROLL_M: f32 = 0.15;
+/// How far a stand-up from the wheels rolls the robot ahead first, m: on the robot as drawn
+/// the unfold pushed it 15 cm back.
+const ROLL_AHEAD_M: f32 = 0.15;
 
-/// Over how long, ms: a half-sine of speed.
-const STAND_PREROLL_MS: u32 = 1_500;
+/// Over how long, ms: a half-sine of speed (a lean of 3° at its steepest).
+const ROLL_AHEAD_MS: u32 = 1_500;
+
+/// A roll ahead still this much short of its distance when its time is up was blocked (by
+/// something the robot touches ahead): the law forgets the rest, so that the robot settles and
+/// stands up where it is instead of pressing on, share of [`ROLL_AHEAD_M`].
+const BLOCKED_SHARE: f32 = 0.5;
+
+/// Where a stand-up's roll ahead is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum RollAhead {
+    /// To come, once the balance law runs with the robot settled and its legs stowed.
+    Due,
+    /// Begun at this tick.
+    Since(Tick),
+    /// Made, or not to be made.
+    Done,
+}
 
 impl Controller {
-    /// The stand-up's speed reference, m/s: the roll ahead once it has begun, else none.
-    pub(super) fn stand_preroll_m_s(&self, now: Tick) -> f32 {
-        let Some(since) = self.stand_preroll else {
+    /// What a transition into `next` keeps of the roll ahead: within a stand-up, all; into a
+    /// stand-up on top of a climbed step, none to make; else one to make.
+    pub(super) fn stand_roll_into(&mut self, next: State) {
+        let within = matches!((self.state, next), (State::Standing(_), State::Standing(_)));
+        if !within {
+            let on_top = self.auto.on_top && matches!(next, State::Standing(_));
+            self.stand_roll = if on_top {
+                RollAhead::Done
+            } else {
+                RollAhead::Due
+            };
+        }
+    }
+
+    /// One tick of the balance law in a stand-up: the roll ahead begins once the robot has
+    /// settled, and at its end a blocked roll's remaining distance is forgotten.
+    pub(super) fn roll_ahead_tick(&mut self, now: Tick) {
+        let due = self.stand_roll == RollAhead::Due;
+        let settled = due && !self.rolling() && !self.leaning_or_stowing();
+        match self.stand_roll {
+            RollAhead::Due if settled => self.stand_roll = RollAhead::Since(now),
+            RollAhead::Since(since) if !self.rolls_ahead_since(since, now) => {
+                if self.balance.position_error_m().abs() > BLOCKED_SHARE * ROLL_AHEAD_M {
+                    self.balance.hold_here();
+                }
+                self.stand_roll = RollAhead::Done;
+            }
+            _ => {}
+        }
+    }
+
+    /// The stand-up's speed reference, m/s: the roll ahead while it runs, else none.
+    pub(super) fn roll_ahead_m_s(&self, now: Tick) -> f32 {
+        let RollAhead::Since(since) = self.stand_roll else {
             return 0.0;
         };
         let t_s = now.since(since) as f32 * self.config.rate.period_s();
-        half_sine_m_s(STAND_PREROLL_M, STAND_PREROLL_MS, t_s)
+        half_sine_m_s(ROLL_AHEAD_M, ROLL_AHEAD_MS, t_s)
     }
 
-    /// Whether the stand-up's roll ahead still runs at `now`; the first call of a stand-up
-    /// (on the wheels, settled and stowed) begins it.
-    pub(super) fn prerolling(&mut self, now: Tick) -> bool {
-        let since = *self.stand_preroll.get_or_insert(now);
-        now.since(since) < self.config.rate.ticks_from_ms(STAND_PREROLL_MS)
+    /// Whether the stand-up still has its roll ahead to make or is making it at `now`.
+    pub(super) fn rolling_ahead(&self, now: Tick) -> bool {
+        match self.stand_roll {
+            RollAhead::Due => true,
+            RollAhead::Since(since) => self.rolls_ahead_since(since, now),
+            RollAhead::Done => false,
+        }
+    }
+
+    fn rolls_ahead_since(&self, since: Tick, now: Tick) -> bool {
+        now.since(since) < self.config.rate.ticks_from_ms(ROLL_AHEAD_MS)
     }
 }

@@ -35,6 +35,9 @@ impl Controller {
             return [0.0; 2];
         }
         self.set_trim_rules(now);
+        if matches!(self.state, State::Standing(_)) {
+            self.roll_ahead_tick(now);
+        }
         let (velocity_ref_m_s, turn_ref_rad_s) = self.wheel_references(now);
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
         let common = self.balance.update(
@@ -132,7 +135,7 @@ impl Controller {
                 (within(self.teleop.speed_m_s, top_m_s), turn(yaw_rad_s))
             }
             State::Folding(_) => (self.fold_return_m_s(now), 0.0),
-            State::Standing(_) => (self.stand_preroll_m_s(now), 0.0),
+            State::Standing(_) => (self.roll_ahead_m_s(now), 0.0),
             _ => (0.0, 0.0),
         }
     }
