@@ -246,6 +246,17 @@ fn checks(scenario: Scenario, obs: &Observation) -> Vec<Check> {
             at_most("stopped within 1 s", s.moved_after_1s_m, 0.05, "m"),
         ],
         Scenario::EStop => estop(obs),
+        Scenario::StandUp => {
+            let standing = matches!(
+                obs.final_state,
+                Some(firmware::control::fsm::State::Legs(_))
+            );
+            vec![
+                never("standing at the end", u64::from(!standing), 1),
+                at_most("moved", s.dx_m.hypot(s.dy_m), 0.05, "m"),
+                at_most("tilt", s.max_tilt_deg, 8.0, "°"),
+            ]
+        }
     }
 }
 

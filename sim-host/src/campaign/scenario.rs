@@ -32,11 +32,13 @@ pub enum Scenario {
     XFromL,
     /// Fold, W at full speed, an E-stop latched at 6 s: an SS1 stop on the wheels.
     EStop,
+    /// Fold, settle, stand up from the wheels: in place (≤ 5 cm), tilt ≤ 8°, standing.
+    StandUp,
 }
 
 impl Scenario {
     /// Every scenario, in the table's order.
-    pub const ALL: [Scenario; 9] = [
+    pub const ALL: [Scenario; 10] = [
         Scenario::W,
         Scenario::S,
         Scenario::A,
@@ -46,6 +48,7 @@ impl Scenario {
         Scenario::XFromW,
         Scenario::XFromL,
         Scenario::EStop,
+        Scenario::StandUp,
     ];
 
     /// The name on the command line and in the table.
@@ -60,6 +63,7 @@ impl Scenario {
             Scenario::XFromW => "X-from-W",
             Scenario::XFromL => "X-from-L",
             Scenario::EStop => "estop-W",
+            Scenario::StandUp => "stand-up",
         }
     }
 
@@ -78,6 +82,7 @@ impl Scenario {
             Scenario::XFromW => &[(0.0, Fold), (3.0, WheelForward), (6.0, Stop)],
             Scenario::XFromL => &[(0.0, Stand), (3.0, TrotForward), (6.0, Stop)],
             Scenario::EStop => &[(0.0, Fold), (1.5, WheelForward)],
+            Scenario::StandUp => &[(0.0, Fold), (STAND_UP_AT_S, Stand)],
         };
         steps
             .iter()
@@ -95,6 +100,7 @@ impl Scenario {
             Scenario::Fold => &[(0.0, "fold"), (4.0, "balance")],
             Scenario::XFromW | Scenario::XFromL => &[(0.0, "start"), (3.0, "move"), (6.0, "X")],
             Scenario::EStop => &[(0.0, "fold"), (1.5, "drive"), (ESTOP_AT_S, "E-stop")],
+            Scenario::StandUp => &[(0.0, "fold, settle"), (STAND_UP_AT_S, "stand-up")],
         }
     }
 
@@ -108,6 +114,8 @@ impl Scenario {
             Scenario::XFromW | Scenario::XFromL => 9.0,
             // The SS1 deadline (2 s) and 2.5 s of rest after it, as tests/estop_ss1.rs.
             Scenario::EStop => ESTOP_AT_S + 4.5,
+            // The stand-up takes 3.2 s as drawn (settling, the roll ahead, the unfold): 6 s.
+            Scenario::StandUp => STAND_UP_AT_S + 6.0,
         }
     }
 
@@ -120,6 +128,9 @@ impl Scenario {
 /// When the E-stop scenario latches, s: at top speed, 4.5 s into W.
 pub const ESTOP_AT_S: f64 = 6.0;
 
+/// When the stand-up scenario asks to stand, s: the fold over and balancing (`fold`'s 4 s).
+pub const STAND_UP_AT_S: f64 = 5.0;
+
 impl fmt::Display for Scenario {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
@@ -128,7 +139,7 @@ impl fmt::Display for Scenario {
 
 /// A name that is no scenario's.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
-#[error("`{0}` is no scenario: use one of W S A L K fold X-from-W X-from-L estop-W")]
+#[error("`{0}` is no scenario: use one of W S A L K fold X-from-W X-from-L estop-W stand-up")]
 pub struct UnknownScenario(pub String);
 
 impl FromStr for Scenario {

@@ -21,7 +21,8 @@ pub(crate) struct CampaignArgs {
     /// Worker threads, each running one MuJoCo instance at a time (default: one per core).
     #[arg(long)]
     pub(crate) jobs: Option<usize>,
-    /// Only this scenario (repeat for several): W S A L K fold X-from-W X-from-L estop-W.
+    /// Only this scenario (repeat for several): W S A L K fold X-from-W X-from-L estop-W
+    /// stand-up.
     #[arg(long = "scenario", value_name = "NAME")]
     pub(crate) scenarios: Vec<Scenario>,
     /// Rerun one trial alone and print its plant and every figure (with --scenario: only that
