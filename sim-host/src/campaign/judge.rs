@@ -7,7 +7,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::campaign::observe::Observation;
-use crate::campaign::scenario::Scenario;
+use crate::campaign::scenario::{Scenario, STAND_UP_AT_S};
 use crate::output::metrics::SegmentSummary;
 
 /// What became of a run, worst first (the order the table lists failures in).
@@ -246,18 +246,35 @@ fn checks(scenario: Scenario, obs: &Observation) -> Vec<Check> {
             at_most("stopped within 1 s", s.moved_after_1s_m, 0.05, "m"),
         ],
         Scenario::EStop => estop(obs),
-        Scenario::StandUp => {
-            let standing = matches!(
-                obs.final_state,
-                Some(firmware::control::fsm::State::Legs(_))
-            );
-            vec![
-                never("standing at the end", u64::from(!standing), 1),
-                at_most("moved", s.dx_m.hypot(s.dy_m), 0.05, "m"),
-                at_most("tilt", s.max_tilt_deg, 8.0, "°"),
-            ]
-        }
+        Scenario::StandUp => stand_up(obs, s),
     }
+}
+
+/// The stand-up from the wheels, as `tests/transitions.rs` asserts it on the robot as drawn:
+/// asked of a robot balancing on its wheels, it ends standing and at rest, within 5 cm of
+/// where the key found it, tilted at most 8° on the way.
+fn stand_up(obs: &Observation, s: &SegmentSummary) -> Vec<Check> {
+    let balancing = obs.balancing_at_s.unwrap_or(f64::INFINITY);
+    let standing = matches!(
+        obs.final_state,
+        Some(firmware::control::fsm::State::Legs(_))
+    );
+    vec![
+        at_most(
+            "balancing on the wheels by the key",
+            balancing,
+            STAND_UP_AT_S,
+            "s",
+        ),
+        never("standing at the end", u64::from(!standing), 1),
+        never(
+            "at rest at the end",
+            u64::from(s.settled_after_s.is_none()),
+            1,
+        ),
+        at_most("moved", s.dx_m.hypot(s.dy_m), 0.05, "m"),
+        at_most("tilt", s.max_tilt_deg, 8.0, "°"),
+    ]
 }
 
 /// W (`sign` 1) or S (−1): the drive segment's figures.
@@ -362,6 +379,7 @@ fn estop(obs: &Observation) -> Vec<Check> {
 mod tests {
     use super::*;
     use crate::campaign::observe::{Abort, JointExcess, StopFigures};
+    use firmware::control::fsm::{LegMotion, State, WheelMotion};
     use protocol::FaultFlags;
 
     fn stopped(off_after_s: f64, speed_m_s: f64, abort: bool) -> Observation {
@@ -405,6 +423,32 @@ mod tests {
         );
         obs.segments.push(tracker.finish());
         obs
+    }
+
+    #[test]
+    fn a_stand_up_passes_standing_at_rest_in_place_and_a_stop_with_a_cause_is_a_safe_abort() {
+        let judged = |state: State, abort: bool, dx_m: f64| {
+            let mut obs = with_segment(stopped(1.0, 0.5, abort));
+            obs.stop = None;
+            obs.final_state = Some(state);
+            let segment = &mut obs.segments[0];
+            segment.dx_m = dx_m;
+            segment.settled_after_s = Some(2.0);
+            segment.max_tilt_deg = 5.0;
+            judge(Scenario::StandUp, &obs)
+        };
+        let standing = State::Legs(LegMotion::Stand);
+        assert_eq!(judged(standing, false, 0.02).outcome, Outcome::Pass);
+        let away = judged(standing, false, 0.2);
+        assert_eq!(
+            (away.outcome, away.check.as_str()),
+            (Outcome::Missed, "moved")
+        );
+        let wheels = State::Wheels(WheelMotion::Balance);
+        let settling = judged(wheels, false, 0.02);
+        assert_eq!(settling.check, "standing at the end");
+        assert_eq!(settling.outcome, Outcome::Missed);
+        assert_eq!(judged(State::Fault, true, 0.02).outcome, Outcome::Aborted);
     }
 
     #[test]
