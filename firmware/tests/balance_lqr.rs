@@ -347,3 +347,57 @@ fn saturates_and_stays_finite_when_it_cannot_win() {
         assert!(balance.position_error_m().abs() <= config.position_error_limit_m);
     }
 }
+
+/// Where a robot whose trim is `trim_error_rad` off its balance point (neither learned nor
+/// followed, as in a stand-up) ends after resting 4 s, moving 15 cm ahead on a half-sine of
+/// speed over 1.5 s and resting 4 s more, relative to where the move began, m.
+fn moved_off_trim(trim_error_rad: f32, counting: bool) -> f64 {
+    let (a, b) = continuous(&BalanceModel::ROBOT);
+    let (ad, bd) = discrete(&a, &b, DT_S);
+    let config = Config::ROBOT.balance;
+    let mut balance = Balance::new(config);
+    balance.set_counting(counting);
+    let mut x = Matrix4x1::new(0.0, 0.0, 0.0, 0.0);
+    let r = BalanceModel::ROBOT.wheel_radius_m as f64;
+    let (rest_s, move_s, distance_m) = (4.0, 1.5, 0.15);
+    let mut start_m = 0.0;
+    for step in 0..((2.0 * rest_s + move_s) / DT_S) as usize {
+        let t_s = step as f64 * DT_S - rest_s;
+        if t_s.abs() < 0.5 * DT_S {
+            start_m = x[0];
+        }
+        let reference = if (0.0..move_s).contains(&t_s) {
+            distance_m / move_s * (1.0 - (std::f64::consts::TAU * t_s / move_s).cos())
+        } else {
+            0.0
+        };
+        let input = BalanceInput {
+            pitch_rad: x[1] as f32 + config.pitch_trim_rad + trim_error_rad,
+            pitch_rate_rad_s: x[3] as f32,
+            wheel_rate_rad_s: (x[2] / r - x[3]) as f32,
+            velocity_ref_m_s: reference as f32,
+        };
+        let torque = balance.update(&input, DT_S as f32);
+        x = ad * x + bd * torque as f64;
+    }
+    x[0] - start_m
+}
+
+#[test]
+fn a_counted_move_makes_its_distance_whatever_the_trim_error() {
+    // A stand-up's roll ahead: its legs' stow moved the balance point 3° away from the trim.
+    // Dropped at the move's start and end, the position error that held the robot was made
+    // up again each time: k_θ/k_p · 3° ≈ 0.15 m off, twice over. Counted, the move is 15 cm.
+    for error_deg in [3.0_f32, -3.0] {
+        let counted_m = moved_off_trim(error_deg.to_radians(), true);
+        assert!(
+            (counted_m - 0.15).abs() < 0.02,
+            "{error_deg}°: counted move {counted_m} m"
+        );
+        let dropped_m = moved_off_trim(error_deg.to_radians(), false);
+        assert!(
+            (dropped_m - 0.15).abs() > 0.1,
+            "{error_deg}°: a move that drops its error made {dropped_m} m"
+        );
+    }
+}

@@ -126,6 +126,9 @@ pub struct Balance {
     rest_s: f32,
     /// The torques the law gave the last ticks, newest first, N·m.
     past_nm: [f32; DESIGN_DELAY_TICKS],
+    /// Whether a motion's start and end keep the position error (see
+    /// [`Balance::set_counting`]).
+    counting: bool,
 }
 
 impl Balance {
@@ -147,6 +150,7 @@ impl Balance {
             holding_place: false,
             rest_s: 0.0,
             past_nm: [0.0; DESIGN_DELAY_TICKS],
+            counting: false,
         }
     }
 
@@ -164,6 +168,16 @@ impl Balance {
     /// robot crept 5 cm after it had stopped.
     pub fn set_place_holding(&mut self, holding: bool) {
         self.holding_place = holding;
+    }
+
+    /// Whether a motion's start and its stop keep the position error instead of dropping it
+    /// (see [`Balance::anchor`]): the law then makes the whole distance its speed reference
+    /// integrates to, from where the count began, and keeps holding what it held before. A
+    /// stand-up's roll ahead is such a move: dropped at its start and its end, the position
+    /// error that held a robot whose trim was off its balance point (its legs moving to the
+    /// stand-up's fold) let it run off by as much each time, backward as often as ahead.
+    pub fn set_counting(&mut self, counting: bool) {
+        self.counting = counting;
     }
 
     /// Lets the trim follow the balance point the lean shows, or not: while the legs are
@@ -337,7 +351,7 @@ impl Balance {
     /// nobody asked for. So once the reference is at rest and the robot's own speed has come to
     /// zero (or changed sign), the remembered position error is dropped, once per stop.
     fn anchor(&mut self, input: &BalanceInput, velocity_ref: f32) {
-        if self.velocity_ref_m_s == 0.0 && velocity_ref != 0.0 {
+        if self.velocity_ref_m_s == 0.0 && velocity_ref != 0.0 && !self.counting {
             self.position_error_m = 0.0;
         }
         self.velocity_ref_m_s = velocity_ref;
@@ -345,7 +359,9 @@ impl Balance {
         if input.velocity_ref_m_s == 0.0 && velocity_ref == 0.0 {
             let stopped = speed * self.last_speed_m_s <= 0.0 || speed.abs() < STOPPED_M_S;
             if !self.anchored && stopped {
-                self.position_error_m = 0.0;
+                if !self.counting {
+                    self.position_error_m = 0.0;
+                }
                 self.anchored = true;
             }
         } else {

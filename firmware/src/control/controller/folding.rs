@@ -137,6 +137,9 @@ impl Controller {
         let wheels = matches!(self.state, State::Wheels(_));
         let tucked = matches!(self.state, State::Folding(_)) && self.fold_done_at.is_some();
         self.balance.set_trim_learning(wheels);
+        // A stand-up's roll ahead makes its distance from where the robot was held.
+        self.balance
+            .set_counting(matches!(self.state, State::Standing(_)));
         self.balance.set_trim_following(wheels || tucked);
         // Only riding clear: the comparison of 16 joints is no work for every tick.
         let settled = wheels && self.auto.riding.clear() && self.legs_at_goal();

@@ -18,18 +18,20 @@ const ROLL_AHEAD_M: f32 = 0.15;
 /// Over how long, ms: a half-sine of speed (a lean of 3° at its steepest).
 const ROLL_AHEAD_MS: u32 = 1_500;
 
-/// A roll ahead still this much short of its distance when its time is up was blocked (by
-/// something the robot touches ahead): the law forgets the rest, so that the robot settles and
-/// stands up where it is instead of pressing on, share of [`ROLL_AHEAD_M`].
+/// A roll ahead whose wheels rolled less than this share of [`ROLL_AHEAD_M`] by the time it is
+/// up was blocked (by something the robot touches ahead): the law forgets the rest, so that the
+/// robot settles and stands up where it is instead of pressing on. Read from the wheels, not
+/// from the law's position error: that also holds whatever the law held before the roll (see
+/// [`crate::wheels::balance::Balance::set_counting`]).
 const BLOCKED_SHARE: f32 = 0.5;
 
 /// Where a stand-up's roll ahead is.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum RollAhead {
     /// To come, once the balance law runs with the robot settled and its legs stowed.
     Due,
-    /// Begun at this tick.
-    Since(Tick),
+    /// Begun at tick `at`, and rolled `rolled_m` over ground since, m.
+    Since { at: Tick, rolled_m: f32 },
     /// Made, or not to be made.
     Done,
 }
@@ -50,17 +52,27 @@ impl Controller {
     }
 
     /// One tick of the balance law in a stand-up: the roll ahead begins once the robot has
-    /// settled, and at its end a blocked roll's remaining distance is forgotten.
-    pub(super) fn roll_ahead_tick(&mut self, now: Tick) {
+    /// settled, counts the ground its wheels roll, and at its end a blocked roll's remaining
+    /// distance is forgotten.
+    pub(super) fn roll_ahead_tick(&mut self, now: Tick, dt_s: f32) {
         let due = self.stand_roll == RollAhead::Due;
         let settled = due && !self.rolling() && !self.leaning_or_stowing();
         match self.stand_roll {
-            RollAhead::Due if settled => self.stand_roll = RollAhead::Since(now),
-            RollAhead::Since(since) if !self.rolls_ahead_since(since, now) => {
-                if self.balance.position_error_m().abs() > BLOCKED_SHARE * ROLL_AHEAD_M {
+            RollAhead::Due if settled => {
+                self.stand_roll = RollAhead::Since {
+                    at: now,
+                    rolled_m: 0.0,
+                }
+            }
+            RollAhead::Since { at, rolled_m } if !self.rolls_ahead_since(at, now) => {
+                if rolled_m < BLOCKED_SHARE * ROLL_AHEAD_M {
                     self.balance.hold_here();
                 }
                 self.stand_roll = RollAhead::Done;
+            }
+            RollAhead::Since { at, rolled_m } => {
+                let rolled_m = rolled_m + self.ground_speed_m_s() * dt_s;
+                self.stand_roll = RollAhead::Since { at, rolled_m };
             }
             _ => {}
         }
@@ -68,10 +80,10 @@ impl Controller {
 
     /// The stand-up's speed reference, m/s: the roll ahead while it runs, else none.
     pub(super) fn roll_ahead_m_s(&self, now: Tick) -> f32 {
-        let RollAhead::Since(since) = self.stand_roll else {
+        let RollAhead::Since { at, .. } = self.stand_roll else {
             return 0.0;
         };
-        let t_s = now.since(since) as f32 * self.config.rate.period_s();
+        let t_s = now.since(at) as f32 * self.config.rate.period_s();
         half_sine_m_s(ROLL_AHEAD_M, ROLL_AHEAD_MS, t_s)
     }
 
@@ -79,7 +91,7 @@ impl Controller {
     pub(super) fn rolling_ahead(&self, now: Tick) -> bool {
         match self.stand_roll {
             RollAhead::Due => true,
-            RollAhead::Since(since) => self.rolls_ahead_since(since, now),
+            RollAhead::Since { at, .. } => self.rolls_ahead_since(at, now),
             RollAhead::Done => false,
         }
     }

@@ -36,7 +36,7 @@ impl Controller {
         }
         self.set_trim_rules(now);
         if matches!(self.state, State::Standing(_)) {
-            self.roll_ahead_tick(now);
+            self.roll_ahead_tick(now, dt_s);
         }
         let (velocity_ref_m_s, turn_ref_rad_s) = self.wheel_references(now);
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
