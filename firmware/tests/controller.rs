@@ -167,6 +167,40 @@ fn a_stand_up_rolls_ahead_once() {
     }
 }
 
+/// The depth of `leg`'s foot below its hip where the bench's legs are, m.
+fn foot_depth_m(bench: &Bench, leg: Leg) -> f32 {
+    use firmware::legs::kinematics::{leg_fk, LegJoints};
+    let joints = LegJoints::from_array(*bench.joints_rad.leg(leg));
+    -leg_fk(&CONFIG.geometry, &joints).z_m
+}
+
+/// Standing after a stand-up from the wheels, a torso pitched 8.6° nose down (front legs giving
+/// way) is lowered at its high end: the back feet come up under their hips. After a stand-up
+/// from the legs the stand keeps every foot at its depth.
+#[test]
+fn a_stand_after_a_stand_up_from_the_wheels_levels_the_torso_in_pitch() {
+    let stand_pitched = |mut bench: Bench| {
+        bench.send(command(TeleopMode::Stand));
+        for _ in 0..ms(8_000) {
+            bench.tick();
+            if bench.state() == State::Legs(LegMotion::Stand) {
+                break;
+            }
+        }
+        assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
+        bench.pitch_rad = 0.15;
+        bench.run(ms(2_000));
+        foot_depth_m(&bench, Leg::Fl) - foot_depth_m(&bench, Leg::Bl)
+    };
+    let risen_m = stand_pitched(Bench::on_the_wheels());
+    assert!(
+        (0.03..=0.05).contains(&risen_m),
+        "back feet {risen_m} m shallower than the front"
+    );
+    let stood_m = stand_pitched(Bench::ready());
+    assert!(stood_m.abs() < 1e-3, "back feet {stood_m} m shallower");
+}
+
 /// A stand-up from the wheels first brings the legs to the fold it starts from, balancing; a
 /// fold asked for meanwhile starts on the wheels, where it has nothing to return: the speed
 /// reference stays at zero (an earlier fold's return must not drive the robot again).

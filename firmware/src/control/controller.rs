@@ -16,6 +16,7 @@ mod carrier;
 mod climbing;
 mod folding;
 mod riding;
+mod stance;
 mod stand_up;
 mod status;
 mod stopping;
@@ -121,6 +122,8 @@ pub struct Controller {
     fold_return: Option<(Tick, f32)>,
     /// Where the running stand-up's roll ahead is (see `stand_up`).
     stand_roll: RollAhead,
+    /// Whether the legs stand after a stand-up from the wheels (see `stance`).
+    risen: bool,
     /// When the running fold's legs were tucked (`None` before, or with no fold).
     fold_done_at: Option<Tick>,
     /// Whether the robot came to balance in place by a stop from a drive or a turn: it then
@@ -183,6 +186,7 @@ impl Controller {
             fold_ahead_m: 0.0,
             fold_return: None,
             stand_roll: RollAhead::Due,
+            risen: false,
             fold_done_at: None,
             stopped_on_wheels: false,
             last_ground_m_s: None,
@@ -452,6 +456,7 @@ impl Controller {
             self.auto.climbed = false;
         }
         self.stand_roll_into(next);
+        self.risen_into(next);
         self.climb_flags_into(next);
         let moving_on_wheels = matches!(self.state, State::Wheels(motion) if motion.moving());
         self.stopped_on_wheels = moving_on_wheels && next == State::Wheels(WheelMotion::Balance);
@@ -470,11 +475,7 @@ impl Controller {
                 &config.limits,
                 &config.posture,
             ),
-            None => {
-                [config
-                    .posture
-                    .stance(&config.geometry, &config.limits, depth_m); 4]
-            }
+            None => self.stance_goals(depth_m),
         };
         for (leg, goal) in Leg::ALL.into_iter().zip(goals) {
             match goal {

@@ -1,0 +1,61 @@
+//! The legs' stance when they neither trot nor walk, and its pitch levelling after a stand-up
+//! from the wheels.
+//!
+//! Unfolded from the wheels, the feet land 8.5 cm behind the front hips and 24.5 cm behind
+//! the back ones, and the front legs carry most of the weight on the way up. On robots with
+//! heavy legs or drives rated low the front hips reached their peak torque as the stand-up
+//! ended, the legs swung back under the torso and the robot tipped 30° nose down onto its
+//! front feet, or over. Standing, the torso tells: it pitches nose down as the front legs
+//! give way. So the legs at the high end lower the torso toward level, which moves the
+//! weight back onto them. Only after a stand-up from the wheels: levelled, a stand after a
+//! trot swayed past the 5 cm an `X` allows.
+
+use super::Controller;
+use crate::control::fsm::{LegMotion, State};
+use crate::legs::kinematics::{IkError, LegJoints};
+
+/// How far the torso may pitch from level before the legs at its high end lower it, rad: past
+/// the attitude estimate's error and a stand's sway.
+const LEVEL_DEADBAND_RAD: f32 = 0.05;
+
+impl Controller {
+    /// Each leg's stance goal `[FL, FR, BL, BR]` at `depth_m` below its hip, the legs at the
+    /// torso's high end shallower by as much as turns it back to within
+    /// [`LEVEL_DEADBAND_RAD`] of level (within the posture's depths), once the legs alone
+    /// carry a robot that stood up from its wheels.
+    pub(super) fn stance_goals(&self, depth_m: f32) -> [Result<LegJoints, IkError>; 4] {
+        let config = &self.config;
+        let posture = &config.posture;
+        let pitch_rad = self.sensors.attitude.pitch_rad;
+        let over_rad =
+            pitch_rad - crate::math::clamp(pitch_rad, -LEVEL_DEADBAND_RAD, LEVEL_DEADBAND_RAD);
+        let levelling = self.risen && !self.wheels_carry() && over_rad.is_finite();
+        let over_rad = if levelling { over_rad } else { 0.0 };
+        // Pitch is positive nose down: the back hips are then the high end.
+        let span_m = 2.0 * config.trot.hips.x_m;
+        let raised = |by_m: f32| {
+            let depth = depth_m - by_m.max(0.0);
+            crate::math::clamp(depth, posture.depth_min_m, posture.depth_max_m)
+        };
+        let front = posture.stance(&config.geometry, &config.limits, raised(-over_rad * span_m));
+        let back = posture.stance(&config.geometry, &config.limits, raised(over_rad * span_m));
+        [front, front, back, back]
+    }
+
+    /// Whether the legs will stand after a stand-up from the wheels once in `next`: from the
+    /// wheels into a stand-up, through it into the stand, and no further.
+    pub(super) fn risen_into(&mut self, next: State) {
+        let from_wheels = matches!(self.state, State::Wheels(_) | State::Folding(_));
+        self.risen = match next {
+            State::Standing(_) => self.risen || from_wheels,
+            State::Legs(LegMotion::Stand) => {
+                self.risen
+                    && matches!(
+                        self.state,
+                        State::Standing(_) | State::Legs(LegMotion::Stand)
+                    )
+            }
+            _ => false,
+        };
+    }
+}
