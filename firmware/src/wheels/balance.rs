@@ -331,6 +331,11 @@ impl Balance {
         self.velocity_ref_m_s
     }
 
+    /// How long the robot has rolled slower than the trim learning's rest speed, s.
+    pub fn rested_s(&self) -> f32 {
+        self.rest_s
+    }
+
     /// The remembered position error, m.
     pub fn position_error_m(&self) -> f32 {
         self.position_error_m

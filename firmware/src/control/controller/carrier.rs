@@ -19,6 +19,12 @@ const STAND_LEAN_RAD: f32 = 0.08;
 /// … or pitches faster than this, rad/s.
 const STAND_STILL_RAD_S: f32 = 0.3;
 
+/// A robot at rest on its wheels this long, s, …
+const STAND_REST_S: f32 = 1.0;
+
+/// … and pitching slower than this, rad/s, leans at its balance point, whatever its trim says.
+const STAND_STEADY_RAD_S: f32 = 0.05;
+
 impl Controller {
     /// Whether the balance law runs (where the wheels are on the ground): in the states that
     /// carry the robot on its wheels, and in `EStop` until the controlled stop cuts the torque.
@@ -100,9 +106,13 @@ impl Controller {
     }
 
     /// Whether a robot on its wheels is not yet settled for a stand-up: it still rolls, or its
-    /// body still leans more than [`STAND_LEAN_RAD`] from its balance point or pitches faster
-    /// than [`STAND_STILL_RAD_S`] (a stop's brake leans it forward by up to 13°; legs unfolded
-    /// under that lean land their front feet first and stand the robot up nose-down), or its
+    /// body still leans more than [`STAND_LEAN_RAD`] from its trim or pitches faster than
+    /// [`STAND_STILL_RAD_S`] (a stop's brake leans it forward by up to 13°; legs unfolded
+    /// under that lean land their front feet first and stand the robot up nose-down) — unless
+    /// it has stood still on its wheels for [`STAND_REST_S`] and pitches slower than
+    /// [`STAND_STEADY_RAD_S`]: its lean is then its balance point (the stow moves that point
+    /// away from the trim, which does not follow it there, and robots whose lean stayed past
+    /// the bound waited on their wheels for good) — or its
     /// legs are not yet at the fold a stand-up starts from
     /// ([`crate::legs::levelling::Levelling::stowed`]), or it has its roll ahead to make or
     /// makes it (`stand_up`).
@@ -116,7 +126,10 @@ impl Controller {
     pub(super) fn leaning_or_stowing(&self) -> bool {
         let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
-        let leaning = lean_rad.abs() > STAND_LEAN_RAD || pitch_rate_rad_s.abs() > STAND_STILL_RAD_S;
+        let steady =
+            self.balance.rested_s() >= STAND_REST_S && pitch_rate_rad_s.abs() < STAND_STEADY_RAD_S;
+        let leaning = (lean_rad.abs() > STAND_LEAN_RAD && !steady)
+            || pitch_rate_rad_s.abs() > STAND_STILL_RAD_S;
         leaning || !self.levelling.stowed()
     }
 
