@@ -401,3 +401,18 @@ fn a_counted_move_makes_its_distance_whatever_the_trim_error() {
         );
     }
 }
+
+#[test]
+fn a_blocked_move_forgives_what_it_did_not_make_and_keeps_the_rest() {
+    let config = Config::ROBOT.balance;
+    let mut balance = Balance::new(config);
+    let bound_m = config.position_error_limit_m;
+    balance.forgive_m(-0.1);
+    assert!((balance.position_error_m() + 0.1).abs() < 1e-6);
+    balance.forgive_m(0.04);
+    assert!((balance.position_error_m() + 0.06).abs() < 1e-6);
+    balance.forgive_m(10.0);
+    assert_eq!(balance.position_error_m(), bound_m);
+    balance.forgive_m(f32::NAN);
+    assert_eq!(balance.position_error_m(), bound_m);
+}

@@ -176,11 +176,23 @@ fn foot_depth_m(bench: &Bench, leg: Leg) -> f32 {
 
 /// Standing after a stand-up from the wheels, a torso pitched 8.6° nose down (front legs giving
 /// way) is lowered at its high end: the back feet come up under their hips. After a stand-up
-/// from the legs the stand keeps every foot at its depth.
+/// from the legs, or once the robot has trotted since, the stand keeps every foot at its depth.
 #[test]
 fn a_stand_after_a_stand_up_from_the_wheels_levels_the_torso_in_pitch() {
-    let stand_pitched = |mut bench: Bench| {
+    let stand_pitched = |mut bench: Bench, trot_first: bool| {
         bench.send(command(TeleopMode::Stand));
+        for _ in 0..ms(8_000) {
+            bench.tick();
+            if bench.state() == State::Legs(LegMotion::Stand) {
+                break;
+            }
+        }
+        if trot_first {
+            bench.send(command(TeleopMode::TrotForward));
+            bench.run(ms(1_000));
+            assert!(matches!(bench.state(), State::Legs(LegMotion::Trot(_))));
+            bench.send(command(TeleopMode::Stop));
+        }
         for _ in 0..ms(8_000) {
             bench.tick();
             if bench.state() == State::Legs(LegMotion::Stand) {
@@ -192,13 +204,18 @@ fn a_stand_after_a_stand_up_from_the_wheels_levels_the_torso_in_pitch() {
         bench.run(ms(2_000));
         foot_depth_m(&bench, Leg::Fl) - foot_depth_m(&bench, Leg::Bl)
     };
-    let risen_m = stand_pitched(Bench::on_the_wheels());
+    let risen_m = stand_pitched(Bench::on_the_wheels(), false);
     assert!(
         (0.03..=0.05).contains(&risen_m),
         "back feet {risen_m} m shallower than the front"
     );
-    let stood_m = stand_pitched(Bench::ready());
+    let stood_m = stand_pitched(Bench::ready(), false);
     assert!(stood_m.abs() < 1e-3, "back feet {stood_m} m shallower");
+    let trotted_m = stand_pitched(Bench::on_the_wheels(), true);
+    assert!(
+        trotted_m.abs() < 1e-3,
+        "after a trot: {trotted_m} m shallower"
+    );
 }
 
 /// A stand-up from the wheels first brings the legs to the fold it starts from, balancing; a

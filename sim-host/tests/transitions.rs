@@ -128,8 +128,50 @@ fn standing_up_from_the_wheels_happens_in_place() {
     let before = [(0.0, TeleopMode::Stop), (0.1, TeleopMode::Fold)];
     let f = transition("stand-up from the wheels", &before, TeleopMode::Stand, 6.0);
     // The unfolding feet push the robot back; it first rolls ahead by about as much
-    // (`control::controller::stand_up`): 2.8 cm and 5.7° (11.5 cm and 6.2° without).
-    assert_in_place(&f, 0.05, 8.0);
+    // (`control::controller::stand_up`), its distance counted by the balance law: 0.6 cm and
+    // 5.7° (2.8 cm with the count dropped, 11.5 cm and 6.2° without the roll). Bound at 2 cm,
+    // inside the goal's 5, so that neither gets lost unnoticed.
+    assert_in_place(&f, 0.02, 8.0);
+}
+
+/// A stand-up asked while the robot drives: the brake stops it, and it stands up where it
+/// stopped. The brake's lag behind the speed reference is no distance to make up: a law that
+/// kept it rolled the robot 20–26 cm on from its stop by itself.
+#[test]
+fn a_stand_up_asked_while_driving_stands_where_the_robot_stopped() {
+    for (what, drive) in [
+        ("stand-up while driving W", TeleopMode::WheelForward),
+        ("stand-up while driving S", TeleopMode::WheelBackward),
+    ] {
+        let plan = vec![
+            PlanStep::at(0.0, TeleopMode::Stop),
+            PlanStep::at(0.1, TeleopMode::Fold),
+            PlanStep::at(5.0, drive),
+            PlanStep::at(7.0, TeleopMode::Stand),
+        ];
+        let clean = Faults::default();
+        let mut rig = Rig::new(Path::new(DEFAULT_MODEL), plan, &clean, &clean).unwrap();
+        rig.run_until(7.0).unwrap();
+        let mut stopped_at = None;
+        while rig.time_s() < 17.0 {
+            rig.step().unwrap();
+            let torso = rig.sim().physics().torso();
+            let speed_m_s = torso.vel_m_s[0].hypot(torso.vel_m_s[1]);
+            if stopped_at.is_none() && speed_m_s < 0.01 {
+                stopped_at = Some(torso.pos_m);
+            }
+        }
+        let stop = stopped_at.expect("the brake stopped the robot");
+        let end = rig.sim().physics().torso().pos_m;
+        let from_stop_m = (end[0] - stop[0]).hypot(end[1] - stop[1]);
+        let state = rig.records().last().unwrap().state;
+        println!("MEASURED {what}: {from_stop_m:.3} m from where it stopped, ended {state:?}");
+        assert_eq!(
+            state,
+            Some(State::Legs(firmware::control::fsm::LegMotion::Stand))
+        );
+        assert!(from_stop_m <= 0.05, "{what}: {from_stop_m} m from its stop");
+    }
 }
 
 /// The stand-up from the wheels on the campaign's robots as built (rated drives, the IMU part

@@ -305,13 +305,13 @@ impl Controller {
                 // standing up flipped it over). The goal is set, so the transition is not
                 // taken as done, but the legs wait, or go to the fold a stand-up starts
                 // from (`Levelling::stow`).
-                self.leg_goal(depth_m);
+                self.leg_goal(now, depth_m);
                 self.stow_legs();
             }
             State::Legs(_) | State::Standing(_) => {
                 self.follow_walk_direction();
                 self.hold_heading(dt_s);
-                self.leg_goal(depth_m);
+                self.leg_goal(now, depth_m);
                 let rate = match self.state {
                     State::Legs(motion) if motion.trotting() => self.config.gait_rate_per_s,
                     _ => self.config.leg_rate_per_s,
@@ -463,7 +463,7 @@ impl Controller {
         self.state = next;
     }
 
-    fn leg_goal(&mut self, depth_m: f32) {
+    fn leg_goal(&mut self, now: Tick, depth_m: f32) {
         let config = &self.config;
         let goals: [Result<LegJoints, _>; 4] = match self.trot_motion() {
             Some((direction, command)) => self.trot.targets(
@@ -475,7 +475,7 @@ impl Controller {
                 &config.limits,
                 &config.posture,
             ),
-            None => self.stance_goals(depth_m),
+            None => self.stance_goals(now, depth_m),
         };
         for (leg, goal) in Leg::ALL.into_iter().zip(goals) {
             match goal {

@@ -129,6 +129,8 @@ pub struct Balance {
     /// Whether a motion's start and end keep the position error (see
     /// [`Balance::set_counting`]).
     counting: bool,
+    /// Whether the running motion began while counting: its stop keeps the error too.
+    counted: bool,
 }
 
 impl Balance {
@@ -151,6 +153,7 @@ impl Balance {
             rest_s: 0.0,
             past_nm: [0.0; DESIGN_DELAY_TICKS],
             counting: false,
+            counted: false,
         }
     }
 
@@ -170,12 +173,14 @@ impl Balance {
         self.holding_place = holding;
     }
 
-    /// Whether a motion's start and its stop keep the position error instead of dropping it
-    /// (see [`Balance::anchor`]): the law then makes the whole distance its speed reference
-    /// integrates to, from where the count began, and keeps holding what it held before. A
-    /// stand-up's roll ahead is such a move: dropped at its start and its end, the position
-    /// error that held a robot whose trim was off its balance point (its legs moving to the
-    /// stand-up's fold) let it run off by as much each time, backward as often as ahead.
+    /// Whether a motion that starts now keeps the position error at its start and its stop
+    /// instead of dropping it (see [`Balance::anchor`]): the law then makes the whole distance
+    /// its speed reference integrates to, and keeps holding what it held before. A stand-up's
+    /// roll ahead is such a move: dropped at its start and its end, the position error that
+    /// held a robot whose trim was off its balance point (its legs moving to the stand-up's
+    /// fold) let it run off by as much each time, backward as often as ahead. A motion that
+    /// began before (a drive the stand-up stops) still drops its error where it stops: the
+    /// brake's lag behind the reference is not a distance to make up.
     pub fn set_counting(&mut self, counting: bool) {
         self.counting = counting;
     }
@@ -272,6 +277,17 @@ impl Balance {
         }
     }
 
+    /// Forgets `behind_m` of the position error the robot is behind its reference by, and
+    /// keeps the rest (within the error's bound): a move that something blocked gives up the
+    /// distance it did not make, not what the law held before it.
+    pub fn forgive_m(&mut self, behind_m: f32) {
+        let bound = self.config.position_error_limit_m;
+        let error_m = self.position_error_m + behind_m;
+        if error_m.is_finite() {
+            self.position_error_m = crate::math::clamp(error_m, -bound, bound);
+        }
+    }
+
     /// Forgets the position error: the robot holds where it is now, not where the error was
     /// counted from (a turn on the spot starts from where the robot is, as a drive does; see
     /// [`Balance::update`]).
@@ -354,17 +370,21 @@ impl Balance {
     /// where it came to rest, not where the speed reference did: the robot lags the reference
     /// while braking, and rolling back to the reference's stop point would be a second motion
     /// nobody asked for. So once the reference is at rest and the robot's own speed has come to
-    /// zero (or changed sign), the remembered position error is dropped, once per stop.
+    /// zero (or changed sign), the remembered position error is dropped, once per stop. A
+    /// motion begun while counting keeps it at both ends ([`Balance::set_counting`]).
     fn anchor(&mut self, input: &BalanceInput, velocity_ref: f32) {
-        if self.velocity_ref_m_s == 0.0 && velocity_ref != 0.0 && !self.counting {
-            self.position_error_m = 0.0;
+        if self.velocity_ref_m_s == 0.0 && velocity_ref != 0.0 {
+            self.counted = self.counting;
+            if !self.counting {
+                self.position_error_m = 0.0;
+            }
         }
         self.velocity_ref_m_s = velocity_ref;
         let speed = self.ground_speed_m_s(input);
         if input.velocity_ref_m_s == 0.0 && velocity_ref == 0.0 {
             let stopped = speed * self.last_speed_m_s <= 0.0 || speed.abs() < STOPPED_M_S;
             if !self.anchored && stopped {
-                if !self.counting {
+                if !(self.counting && self.counted) {
                     self.position_error_m = 0.0;
                 }
                 self.anchored = true;

@@ -6,13 +6,16 @@
 //! heavy legs or drives rated low the front hips reached their peak torque as the stand-up
 //! ended, the legs swung back under the torso and the robot tipped 30° nose down onto its
 //! front feet, or over. Standing, the torso tells: it pitches nose down as the front legs
-//! give way. So the legs at the high end lower the torso toward level, which moves the
-//! weight back onto them. Only after a stand-up from the wheels: levelled, a stand after a
-//! trot swayed past the 5 cm an `X` allows.
+//! give way. So the legs at the high end stand shallower by what the torso pitches past a
+//! deadband, which moves the weight back onto them. Recomputed every tick from the measured
+//! pitch, it is a proportional correction: a torso that would pitch θ₀ ends halfway between θ₀
+//! and the deadband (within the posture's depths). Only after a stand-up from the wheels:
+//! levelled, a stand after a trot swayed past the 5 cm an `X` allows.
 
 use super::Controller;
 use crate::control::fsm::{LegMotion, State};
 use crate::legs::kinematics::{IkError, LegJoints};
+use crate::time::Tick;
 
 /// How far the torso may pitch from level before the legs at its high end lower it, rad: past
 /// the attitude estimate's error and a stand's sway.
@@ -20,16 +23,19 @@ const LEVEL_DEADBAND_RAD: f32 = 0.05;
 
 impl Controller {
     /// Each leg's stance goal `[FL, FR, BL, BR]` at `depth_m` below its hip, the legs at the
-    /// torso's high end shallower by as much as turns it back to within
-    /// [`LEVEL_DEADBAND_RAD`] of level (within the posture's depths), once the legs alone
-    /// carry a robot that stood up from its wheels.
-    pub(super) fn stance_goals(&self, depth_m: f32) -> [Result<LegJoints, IkError>; 4] {
+    /// torso's high end shallower by as much as would turn it by what it pitches past
+    /// [`LEVEL_DEADBAND_RAD`] (within the posture's depths), once the legs alone carry a robot
+    /// that stood up from its wheels and its attitude is known at `now`.
+    pub(super) fn stance_goals(&self, now: Tick, depth_m: f32) -> [Result<LegJoints, IkError>; 4] {
         let config = &self.config;
         let posture = &config.posture;
         let pitch_rad = self.sensors.attitude.pitch_rad;
         let over_rad =
             pitch_rad - crate::math::clamp(pitch_rad, -LEVEL_DEADBAND_RAD, LEVEL_DEADBAND_RAD);
-        let levelling = self.risen && !self.wheels_carry() && over_rad.is_finite();
+        let levelling = self.risen
+            && !self.wheels_carry()
+            && self.sensors.attitude_known(now)
+            && over_rad.is_finite();
         let over_rad = if levelling { over_rad } else { 0.0 };
         // Pitch is positive nose down: the back hips are then the high end.
         let span_m = 2.0 * config.trot.hips.x_m;
@@ -42,12 +48,19 @@ impl Controller {
         [front, front, back, back]
     }
 
-    /// Whether the legs will stand after a stand-up from the wheels once in `next`: from the
-    /// wheels into a stand-up, through it into the stand, and no further.
+    /// Whether the legs will stand after a stand-up from the wheels once in `next`: into a
+    /// stand-up from the wheels or a fold, or from a state whose legs this tick has already
+    /// found on the wheels, through it into the stand, and no further. (A fold stopped before
+    /// its feet left the ground counts as from the wheels: its stand is levelled as well.
+    /// Finding the stance on the transition's tick for it cost 1,200 instructions at the MCU's
+    /// worst tick.)
     pub(super) fn risen_into(&mut self, next: State) {
-        let from_wheels = matches!(self.state, State::Wheels(_) | State::Folding(_));
+        let standing = matches!(self.state, State::Standing(_));
         self.risen = match next {
-            State::Standing(_) => self.risen || from_wheels,
+            State::Standing(_) if standing => self.risen,
+            State::Standing(_) => {
+                matches!(self.state, State::Wheels(_) | State::Folding(_)) || self.wheels_carry()
+            }
             State::Legs(LegMotion::Stand) => {
                 self.risen
                     && matches!(

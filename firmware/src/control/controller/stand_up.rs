@@ -19,10 +19,10 @@ const ROLL_AHEAD_M: f32 = 0.15;
 const ROLL_AHEAD_MS: u32 = 1_500;
 
 /// A roll ahead whose wheels rolled less than this share of [`ROLL_AHEAD_M`] by the time it is
-/// up was blocked (by something the robot touches ahead): the law forgets the rest, so that the
-/// robot settles and stands up where it is instead of pressing on. Read from the wheels, not
-/// from the law's position error: that also holds whatever the law held before the roll (see
-/// [`crate::wheels::balance::Balance::set_counting`]).
+/// up was blocked (by something the robot touches ahead): the law forgets the distance it did
+/// not make, so that the robot settles and stands up where it is instead of pressing on. Read
+/// from the wheels, not from the law's position error, which also holds what the law held
+/// before the roll (see [`crate::wheels::balance::Balance::set_counting`]), and kept.
 const BLOCKED_SHARE: f32 = 0.5;
 
 /// Where a stand-up's roll ahead is.
@@ -65,8 +65,10 @@ impl Controller {
                 }
             }
             RollAhead::Since { at, rolled_m } if !self.rolls_ahead_since(at, now) => {
+                // A roll whose distance cannot be read counts as blocked, as having rolled none.
+                let rolled_m = if rolled_m.is_finite() { rolled_m } else { 0.0 };
                 if rolled_m < BLOCKED_SHARE * ROLL_AHEAD_M {
-                    self.balance.hold_here();
+                    self.balance.forgive_m(ROLL_AHEAD_M - rolled_m);
                 }
                 self.stand_roll = RollAhead::Done;
             }
