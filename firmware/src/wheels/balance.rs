@@ -174,7 +174,7 @@ impl Balance {
     }
 
     /// Whether a motion that starts now keeps the position error at its start and its stop
-    /// instead of dropping it (see [`Balance::anchor`]): the law then makes the whole distance
+    /// instead of dropping it (see `Balance::anchor`): the law then makes the whole distance
     /// its speed reference integrates to, and keeps holding what it held before. A stand-up's
     /// roll ahead is such a move: dropped at its start and its end, the position error that
     /// held a robot whose trim was off its balance point (its legs moving to the stand-up's
