@@ -179,26 +179,24 @@ fn foot_depth_m(bench: &Bench, leg: Leg) -> f32 {
 /// from the legs, or once the robot has trotted since, the stand keeps every foot at its depth.
 #[test]
 fn a_stand_after_a_stand_up_from_the_wheels_levels_the_torso_in_pitch() {
-    let stand_pitched = |mut bench: Bench, trot_first: bool| {
-        bench.send(command(TeleopMode::Stand));
+    let until_standing = |bench: &mut Bench| {
         for _ in 0..ms(8_000) {
             bench.tick();
             if bench.state() == State::Legs(LegMotion::Stand) {
                 break;
             }
         }
+    };
+    let stand_pitched = |mut bench: Bench, trot_first: bool| {
+        bench.send(command(TeleopMode::Stand));
+        until_standing(&mut bench);
         if trot_first {
             bench.send(command(TeleopMode::TrotForward));
             bench.run(ms(1_000));
             assert!(matches!(bench.state(), State::Legs(LegMotion::Trot(_))));
             bench.send(command(TeleopMode::Stop));
         }
-        for _ in 0..ms(8_000) {
-            bench.tick();
-            if bench.state() == State::Legs(LegMotion::Stand) {
-                break;
-            }
-        }
+        until_standing(&mut bench);
         assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
         bench.pitch_rad = 0.15;
         bench.run(ms(2_000));

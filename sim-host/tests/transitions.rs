@@ -136,7 +136,7 @@ fn standing_up_from_the_wheels_happens_in_place() {
 
 /// A stand-up asked while the robot drives: the brake stops it, and it stands up where it
 /// stopped. The brake's lag behind the speed reference is no distance to make up: a law that
-/// kept it rolled the robot 20–26 cm on from its stop by itself.
+/// kept it rolled the robot 15–26 cm on from its stop by itself.
 #[test]
 fn a_stand_up_asked_while_driving_stands_where_the_robot_stopped() {
     for (what, drive) in [

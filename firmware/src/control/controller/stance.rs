@@ -36,7 +36,9 @@ impl Controller {
             && !self.wheels_carry()
             && self.sensors.attitude_known(now)
             && over_rad.is_finite();
-        let over_rad = if levelling { over_rad } else { 0.0 };
+        if !levelling {
+            return [posture.stance(&config.geometry, &config.limits, depth_m); 4];
+        }
         // Pitch is positive nose down: the back hips are then the high end.
         let span_m = 2.0 * config.trot.hips.x_m;
         let raised = |by_m: f32| {
@@ -58,9 +60,8 @@ impl Controller {
         let standing = matches!(self.state, State::Standing(_));
         self.risen = match next {
             State::Standing(_) if standing => self.risen,
-            State::Standing(_) => {
-                matches!(self.state, State::Wheels(_) | State::Folding(_)) || self.wheels_carry()
-            }
+            // `wheels_carry` holds on the wheels whatever the stance.
+            State::Standing(_) => matches!(self.state, State::Folding(_)) || self.wheels_carry(),
             State::Legs(LegMotion::Stand) => {
                 self.risen
                     && matches!(
