@@ -7,10 +7,11 @@
 
 use std::path::Path;
 
-use firmware::control::fsm::State;
+use firmware::control::fsm::{LegMotion, State};
 use host_can::fault_plan::Faults;
 use protocol::TeleopMode;
 use sim_host::campaign::draw::Draws;
+use sim_host::campaign::scenario::Scenario;
 use sim_host::campaign::Drives;
 use sim_host::faults::rig::Rig;
 use sim_host::robot::model::DEFAULT_MODEL;
@@ -166,11 +167,38 @@ fn a_stand_up_asked_while_driving_stands_where_the_robot_stopped() {
         let from_stop_m = (end[0] - stop[0]).hypot(end[1] - stop[1]);
         let state = rig.records().last().unwrap().state;
         println!("MEASURED {what}: {from_stop_m:.3} m from where it stopped, ended {state:?}");
-        assert_eq!(
-            state,
-            Some(State::Legs(firmware::control::fsm::LegMotion::Stand))
-        );
+        assert_eq!(state, Some(State::Legs(LegMotion::Stand)));
         assert!(from_stop_m <= 0.05, "{what}: {from_stop_m} m from its stop");
+    }
+}
+
+/// Campaign robots (0, 7, 8, 16, 25, 55 and 61, rated drives, their own IMU parts, delay)
+/// whose front feet landed first as the legs unfolded rocked back onto their back feet, 15°
+/// from their trim, and waited there for good: the rule that holds the legs while a robot on
+/// its wheels leans kept holding them on wheels and feet. Still there for a second, they now
+/// stand up, and none falls.
+#[test]
+fn a_stand_up_that_rocks_back_onto_its_back_feet_stands_up() {
+    for seed in [0, 7, 8, 16, 25, 55, 61] {
+        let clean = Faults::default();
+        let plant = Draws::of(seed).plant(Drives::Rated.ratings());
+        let model = Path::new(DEFAULT_MODEL);
+        let plan = Scenario::StandUp.plan();
+        let mut rig = Rig::with_plant(model, plan, &clean, &clean, plant).unwrap();
+        let mut fallen = false;
+        while rig.time_s() < 13.0 {
+            rig.step().unwrap();
+            fallen |= rig.records().last().unwrap().fallen();
+        }
+        let state = rig.records().last().unwrap().state;
+        let height_m = rig.sim().physics().torso().pos_m[2];
+        println!("MEASURED robot {seed}: ended {state:?}, torso {height_m:.3} m high");
+        assert!(!fallen, "robot {seed} fell");
+        assert_eq!(state, Some(State::Legs(LegMotion::Stand)), "robot {seed}");
+        assert!(
+            height_m > 0.33,
+            "robot {seed} at {height_m} m: not on its legs"
+        );
     }
 }
 

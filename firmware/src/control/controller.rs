@@ -24,7 +24,7 @@ mod supervise;
 mod walking;
 mod wheel_law;
 
-use protocol::{AnyMessage, DriveFlags, EStopAction, FaultFlags, Joints, Leg, PerDrive};
+use protocol::{AnyMessage, DriveFlags, EStopAction, FaultFlags, Joints, PerDrive};
 
 use crate::config::Config;
 use crate::control::estimator::AttitudeEstimator;
@@ -37,7 +37,6 @@ use crate::control::stop::Stop;
 use crate::control::teleop::Teleop;
 use crate::legs::blocked::BlockedSwings;
 use crate::legs::gait::Trot;
-use crate::legs::kinematics::LegJoints;
 use crate::legs::levelling::Levelling;
 use crate::legs::smoothing::Smoother;
 use crate::legs::support::LegStance;
@@ -124,6 +123,8 @@ pub struct Controller {
     stand_roll: RollAhead,
     /// Whether the legs stand after a stand-up from the wheels (see `stance`).
     risen: bool,
+    /// How long a stand-up's unfold has sat still on wheels and feet, s (see `stand_up`).
+    feet_still_s: f32,
     /// When the running fold's legs were tucked (`None` before, or with no fold).
     fold_done_at: Option<Tick>,
     /// Whether the robot came to balance in place by a stop from a drive or a turn: it then
@@ -187,6 +188,7 @@ impl Controller {
             fold_return: None,
             stand_roll: RollAhead::Due,
             risen: false,
+            feet_still_s: 0.0,
             fold_done_at: None,
             stopped_on_wheels: false,
             last_ground_m_s: None,
@@ -461,28 +463,6 @@ impl Controller {
         let moving_on_wheels = matches!(self.state, State::Wheels(motion) if motion.moving());
         self.stopped_on_wheels = moving_on_wheels && next == State::Wheels(WheelMotion::Balance);
         self.state = next;
-    }
-
-    fn leg_goal(&mut self, now: Tick, depth_m: f32) {
-        let config = &self.config;
-        let goals: [Result<LegJoints, _>; 4] = match self.trot_motion() {
-            Some((direction, command)) => self.trot.targets(
-                direction,
-                config.posture.trot_depth_for(self.teleop.body_height_m),
-                &command,
-                &self.sensors.attitude,
-                &config.geometry,
-                &config.limits,
-                &config.posture,
-            ),
-            None => self.stance_goals(now, depth_m),
-        };
-        for (leg, goal) in Leg::ALL.into_iter().zip(goals) {
-            match goal {
-                Ok(joints) => *self.goal_rad.leg_mut(leg) = joints.to_array(),
-                Err(_) => self.ik_failures = self.ik_failures.saturating_add(1),
-            }
-        }
     }
 
     fn smooth(&mut self, rate_per_s: f32) {

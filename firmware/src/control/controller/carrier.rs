@@ -19,7 +19,8 @@ const STAND_LEAN_RAD: f32 = 0.08;
 /// … or pitches faster than this, rad/s.
 const STAND_STILL_RAD_S: f32 = 0.3;
 
-/// A robot at rest on its wheels this long, s, …
+/// A robot at rest on its wheels, or once its legs unfold still on wheels and feet, this long,
+/// s, …
 const STAND_REST_S: f32 = 1.0;
 
 /// … and pitching slower than this, rad/s, leans at its balance point, whatever its trim says.
@@ -112,8 +113,11 @@ impl Controller {
     /// it has stood still on its wheels for [`STAND_REST_S`] and pitches slower than
     /// [`STAND_STEADY_RAD_S`]: its lean is then its balance point (the stow moves that point
     /// away from the trim, which does not follow it there, and robots whose lean stayed past
-    /// the bound waited on their wheels for good) — or its
-    /// legs are not yet at the fold a stand-up starts from
+    /// the bound waited on their wheels for good), or, once its legs unfold, has sat as long
+    /// still on wheels and feet: its feet then set its pitch (robots whose front feet landed
+    /// first rocked back onto their back feet, 15° from the trim, and their legs waited for
+    /// good: 60 of the campaign's 500) — or its legs are not yet at the fold a stand-up starts
+    /// from
     /// ([`crate::legs::levelling::Levelling::stowed`]), or it has its roll ahead to make or
     /// makes it (`stand_up`).
     pub(super) fn unsettled(&mut self, now: Tick) -> bool {
@@ -126,8 +130,8 @@ impl Controller {
     pub(super) fn leaning_or_stowing(&self) -> bool {
         let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
-        let steady =
-            self.balance.rested_s() >= STAND_REST_S && pitch_rate_rad_s.abs() < STAND_STEADY_RAD_S;
+        let rested = self.balance.rested_s().max(self.feet_still_s);
+        let steady = rested >= STAND_REST_S && pitch_rate_rad_s.abs() < STAND_STEADY_RAD_S;
         let leaning = (lean_rad.abs() > STAND_LEAN_RAD && !steady)
             || pitch_rate_rad_s.abs() > STAND_STILL_RAD_S;
         leaning || !self.levelling.stowed()

@@ -196,7 +196,9 @@ impl Controller {
             return true;
         }
         let support = self.config.support;
-        self.stance().height_m >= support.wheel_contact_height_m - support.margin_m
+        let on_feet = self.stance().height_m >= support.wheel_contact_height_m - support.margin_m;
+        self.count_still_on_feet(on_feet);
+        on_feet
     }
 
     /// Whether every commanded joint is within the pose tolerance of its goal.

@@ -1,5 +1,5 @@
-//! The legs' stance when they neither trot nor walk, and its pitch levelling after a stand-up
-//! from the wheels.
+//! The legs' goal each tick: the trot's targets, or the stance when they neither trot nor walk,
+//! and its pitch levelling after a stand-up from the wheels.
 //!
 //! Unfolded from the wheels, the feet land 8.5 cm behind the front hips and 24.5 cm behind
 //! the back ones, and the front legs carry most of the weight on the way up. On robots with
@@ -16,6 +16,7 @@ use super::Controller;
 use crate::control::fsm::{LegMotion, State};
 use crate::legs::kinematics::{IkError, LegJoints};
 use crate::time::Tick;
+use protocol::Leg;
 
 /// How far the torso may pitch from level before the legs at its high end lower it, rad: past
 /// the attitude estimate's error and a stand's sway.
@@ -71,5 +72,30 @@ impl Controller {
             }
             _ => false,
         };
+    }
+
+    /// This tick's goal for every leg (`goal_rad`): the trot's targets while it trots, else
+    /// the stance at `depth_m` ([`Controller::stance_goals`]). A goal the IK refuses keeps the
+    /// leg's last one and is counted.
+    pub(super) fn leg_goal(&mut self, now: Tick, depth_m: f32) {
+        let config = &self.config;
+        let goals: [Result<LegJoints, _>; 4] = match self.trot_motion() {
+            Some((direction, command)) => self.trot.targets(
+                direction,
+                config.posture.trot_depth_for(self.teleop.body_height_m),
+                &command,
+                &self.sensors.attitude,
+                &config.geometry,
+                &config.limits,
+                &config.posture,
+            ),
+            None => self.stance_goals(now, depth_m),
+        };
+        for (leg, goal) in Leg::ALL.into_iter().zip(goals) {
+            match goal {
+                Ok(joints) => *self.goal_rad.leg_mut(leg) = joints.to_array(),
+                Err(_) => self.ik_failures = self.ik_failures.saturating_add(1),
+            }
+        }
     }
 }

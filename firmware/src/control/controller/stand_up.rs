@@ -25,6 +25,9 @@ const ROLL_AHEAD_MS: u32 = 1_500;
 /// before the roll (see [`crate::wheels::balance::Balance::set_counting`]), and kept.
 const BLOCKED_SHARE: f32 = 0.5;
 
+/// Pitch rate below which a robot on its wheels and feet counts as still, rad/s.
+const STILL_RAD_S: f32 = 0.05;
+
 /// Where a stand-up's roll ahead is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum RollAhead {
@@ -100,5 +103,21 @@ impl Controller {
 
     fn rolls_ahead_since(&self, since: Tick, now: Tick) -> bool {
         now.since(since) < self.config.rate.ticks_from_ms(ROLL_AHEAD_MS)
+    }
+
+    /// Counts how long a stand-up whose legs have begun to unfold (its roll ahead made) has sat
+    /// still on its wheels and feet (`on_feet`, pitching slower than [`STILL_RAD_S`]): see
+    /// [`Controller::leaning_or_stowing`]. Anything else starts the count afresh.
+    pub(super) fn count_still_on_feet(&mut self, on_feet: bool) {
+        let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
+        let still = on_feet
+            && matches!(self.state, State::Standing(_))
+            && self.stand_roll == RollAhead::Done
+            && pitch_rate_rad_s.abs() < STILL_RAD_S;
+        self.feet_still_s = if still {
+            self.feet_still_s + self.config.rate.period_s()
+        } else {
+            0.0
+        };
     }
 }
