@@ -216,6 +216,54 @@ fn a_stand_after_a_stand_up_from_the_wheels_levels_the_torso_in_pitch() {
     );
 }
 
+/// A stand after a stand-up from the wheels whose torso stays pitched past 15° for a second
+/// (front legs that gave way on the way up) is reported, `stand_tilted`, until the operator's
+/// next request; nothing moves for it. A stand within the levelling's reach, or one that did
+/// not rise from the wheels, is not.
+#[test]
+fn a_stand_after_a_stand_up_that_stays_tilted_is_reported_until_the_next_request() {
+    let stand_pitched = |mut bench: Bench, pitch_rad: f32| {
+        bench.send(command(TeleopMode::Stand));
+        for _ in 0..ms(8_000) {
+            bench.tick();
+            if bench.state() == State::Legs(LegMotion::Stand) {
+                break;
+            }
+        }
+        assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
+        bench.pitch_rad = pitch_rad;
+        let mut first_ms = None;
+        for tick in 0..ms(2_000) {
+            let faults = bench.tick().status.faults;
+            if first_ms.is_none() && faults.contains(FaultFlags::STAND_TILTED) {
+                first_ms = Some(tick * 4);
+            }
+        }
+        (bench, first_ms)
+    };
+    let (mut bench, first_ms) = stand_pitched(Bench::on_the_wheels(), 0.5);
+    let first_ms = first_ms.expect("a stand 29 deg nose down is reported");
+    assert!(
+        (1_000..1_100).contains(&first_ms),
+        "reported after {first_ms} ms"
+    );
+    assert_eq!(
+        bench.state(),
+        State::Legs(LegMotion::Stand),
+        "nothing moves"
+    );
+    bench.send(command(TeleopMode::Stop));
+    let faults = bench.tick().status.faults;
+    assert!(
+        !faults.contains(FaultFlags::STAND_TILTED),
+        "cleared by the request"
+    );
+    let (_, within) = stand_pitched(Bench::on_the_wheels(), 0.2);
+    assert_eq!(within, None, "11 deg is the levelling's to take");
+    let (_, from_legs) = stand_pitched(Bench::ready(), 0.5);
+    assert_eq!(from_legs, None, "a stand from the legs is not watched");
+}
+
 /// A stand-up from the wheels first brings the legs to the fold it starts from, balancing; a
 /// fold asked for meanwhile starts on the wheels, where it has nothing to return: the speed
 /// reference stays at zero (an earlier fold's return must not drive the robot again).

@@ -37,7 +37,7 @@ pub use crate::units::{Epoch, SessionTime};
 
 /// The wire version this build speaks. Nodes refuse an announcement of another version: the
 /// layouts differ, and a node that guessed would misread every frame.
-pub const WIRE_VERSION: u8 = 11;
+pub const WIRE_VERSION: u8 = 12;
 
 /// An AES-128 key shared by the robot's nodes and its operators.
 ///

@@ -298,6 +298,11 @@ wire_flags!(
         /// return over 1.5 m of level ground: it would drive blind toward what it cannot see,
         /// so the robot stopped and balances; cleared by the operator's next request.
         RANGE_TIMEOUT = 14 => "range_timeout",
+        /// A stand-up from the wheels left the torso on its legs pitched past 15° for a
+        /// second (front legs at their rating that gave way, or back legs at their shallowest
+        /// that cannot level it): the legs hold where they are, nothing else moves; cleared by
+        /// the operator's next request (a fold brings the robot back onto its wheels).
+        STAND_TILTED = 15 => "stand_tilted",
     }
 );
 

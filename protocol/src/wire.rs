@@ -252,7 +252,7 @@ macro_rules! wire_flags {
 
             /// From raw bits; `None` if a bit without a name is set.
             pub const fn from_bits(bits: $raw) -> Option<Self> {
-                if bits & !Self::KNOWN == 0 {
+                if bits | Self::KNOWN == Self::KNOWN {
                     Some(Self(bits))
                 } else {
                     None

@@ -134,6 +134,7 @@ fn expected_signals(message: &AnyMessage) -> Vec<(String, f64, f64)> {
                 "leg_blocked",
                 "step_refused",
                 "range_timeout",
+                "stand_tilted",
             ];
             for (bit, flag) in flags.iter().enumerate() {
                 put(

@@ -9,7 +9,7 @@ use std::path::Path;
 
 use firmware::control::fsm::{LegMotion, State};
 use host_can::fault_plan::Faults;
-use protocol::TeleopMode;
+use protocol::{FaultFlags, TeleopMode};
 use sim_host::campaign::draw::Draws;
 use sim_host::campaign::scenario::Scenario;
 use sim_host::campaign::Drives;
@@ -199,6 +199,45 @@ fn a_stand_up_that_rocks_back_onto_its_back_feet_stands_up() {
             height_m > 0.33,
             "robot {seed} at {height_m} m: not on its legs"
         );
+    }
+}
+
+/// Campaign robots (27 and 56) whose front legs give way as they unfold stand 30° nose down on
+/// their front feet: the controller says so (`stand_tilted`) and holds them there. The robot as
+/// drawn stands up level and says nothing.
+#[test]
+fn a_stand_up_that_ends_nose_down_is_reported() {
+    let clean = Faults::default();
+    let model = Path::new(DEFAULT_MODEL);
+    for seed in [Some(27), Some(56), None] {
+        let plant = seed.map_or_else(Default::default, |seed| {
+            Draws::of(seed).plant(Drives::Rated.ratings())
+        });
+        let plan = Scenario::StandUp.plan();
+        let mut rig = Rig::with_plant(model, plan, &clean, &clean, plant).unwrap();
+        let mut reported_at_s = None;
+        while rig.time_s() < 13.0 {
+            rig.step().unwrap();
+            let record = rig.records().last().unwrap();
+            if reported_at_s.is_none() && record.faults.contains(FaultFlags::STAND_TILTED) {
+                reported_at_s = Some(rig.time_s());
+            }
+        }
+        let record = rig.records().last().unwrap();
+        let pitch_deg = rig.sim().physics().torso().rpy_rad()[1].to_degrees();
+        println!(
+            "MEASURED robot {seed:?}: pitch {pitch_deg:.1}°, ended {:?}, stand_tilted from \
+             {reported_at_s:?} s",
+            record.state
+        );
+        assert_eq!(record.state, Some(State::Legs(LegMotion::Stand)));
+        match seed {
+            Some(_) => {
+                assert!(pitch_deg > 25.0, "robot {seed:?} at {pitch_deg}°");
+                assert!(record.faults.contains(FaultFlags::STAND_TILTED));
+            }
+            None => assert_eq!(reported_at_s, None, "the drawn robot stands level"),
+        }
     }
 }
 

@@ -48,6 +48,7 @@ use crate::wheels::runaway::Runaway;
 use crate::wheels::traction::Traction;
 use crate::wheels::wheel::SpeedLoop;
 use climbing::Autonomy;
+use stance::StandTilt;
 use stand_up::RollAhead;
 
 /// How fast the turn reference changes, rad/s² of wheel rate: a step to the turn's full
@@ -125,6 +126,8 @@ pub struct Controller {
     risen: bool,
     /// How long a stand-up's unfold has sat still on wheels and feet, s (see `stand_up`).
     feet_still_s: f32,
+    /// Whether a stand after a stand-up from the wheels has stayed tilted (see `stance`).
+    stand_tilt: StandTilt,
     /// When the running fold's legs were tucked (`None` before, or with no fold).
     fold_done_at: Option<Tick>,
     /// Whether the robot came to balance in place by a stop from a drive or a turn: it then
@@ -189,6 +192,7 @@ impl Controller {
             stand_roll: RollAhead::Due,
             risen: false,
             feet_still_s: 0.0,
+            stand_tilt: StandTilt::default(),
             fold_done_at: None,
             stopped_on_wheels: false,
             last_ground_m_s: None,
@@ -329,6 +333,7 @@ impl Controller {
         }
         let mut wheel_torque_nm = self.wheel_torques(now, dt_s);
         self.level(dt_s);
+        self.watch_stand_tilt(now);
         self.watch_swings();
         if matches!(self.state, State::Legs(motion) if motion.trotting()) {
             self.trot.advance();
@@ -398,6 +403,7 @@ impl Controller {
             self.leg_blocked = false;
             self.auto.step_refused = false;
             self.auto.range_lost = false;
+            self.stand_tilt = StandTilt::default();
         }
         let next = self.state.next(event);
         if next == self.state {

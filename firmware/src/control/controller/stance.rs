@@ -22,6 +22,31 @@ use protocol::Leg;
 /// the attitude estimate's error and a stand's sway.
 const LEVEL_DEADBAND_RAD: f32 = 0.05;
 
+/// A stand after a stand-up from the wheels whose torso stays pitched further than this,
+/// rad (15°), …
+const TILT_REPORT_RAD: f32 = 0.26;
+
+/// … for this long, ms, is reported ([`protocol::FaultFlags::STAND_TILTED`]): the levelling
+/// has reached its depths, or the legs at the low end give way.
+const TILT_REPORT_MS: u32 = 1_000;
+
+/// The watch on a stand after a stand-up from the wheels that stays tilted.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(super) struct StandTilt {
+    /// Since when the torso has been pitched past [`TILT_REPORT_RAD`].
+    since: Option<Tick>,
+    /// Whether it has stayed so for [`TILT_REPORT_MS`]: kept until the operator's next
+    /// request.
+    reported: bool,
+}
+
+impl StandTilt {
+    /// Whether the stand is reported tilted.
+    pub(super) fn reported(&self) -> bool {
+        self.reported
+    }
+}
+
 impl Controller {
     /// Each leg's stance goal `[FL, FR, BL, BR]` at `depth_m` below its hip, the legs at the
     /// torso's high end shallower by as much as would turn it by what it pitches past
@@ -49,6 +74,29 @@ impl Controller {
         let front = posture.stance(&config.geometry, &config.limits, raised(-over_rad * span_m));
         let back = posture.stance(&config.geometry, &config.limits, raised(over_rad * span_m));
         [front, front, back, back]
+    }
+
+    /// One tick of the watch on the stand after a stand-up from the wheels: a torso its legs
+    /// carry, pitched past [`TILT_REPORT_RAD`] for [`TILT_REPORT_MS`], is reported. Robots
+    /// whose front legs gave way on the way up stood 30–32° nose down on their front feet,
+    /// their front drives at their rating, and nothing said so. Nothing moves for it: the
+    /// operator decides (a fold takes the robot back onto its wheels).
+    pub(super) fn watch_stand_tilt(&mut self, now: Tick) {
+        let standing = matches!(
+            self.state,
+            State::Standing(_) | State::Legs(LegMotion::Stand)
+        ) && self.risen
+            && !self.wheels_carry()
+            && self.sensors.attitude_known(now);
+        let tilted = standing && self.sensors.attitude.pitch_rad.abs() > TILT_REPORT_RAD;
+        if !tilted {
+            self.stand_tilt.since = None;
+            return;
+        }
+        let since = *self.stand_tilt.since.get_or_insert(now);
+        if now.since(since) >= self.config.rate.ticks_from_ms(TILT_REPORT_MS) {
+            self.stand_tilt.reported = true;
+        }
     }
 
     /// Whether the legs will stand after a stand-up from the wheels once in `next`: into a

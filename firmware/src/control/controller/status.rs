@@ -32,6 +32,9 @@ impl Controller {
         if self.auto.range_lost {
             faults = faults.with(FaultFlags::RANGE_TIMEOUT);
         }
+        if self.stand_tilt.reported() {
+            faults = faults.with(FaultFlags::STAND_TILTED);
+        }
         if self.teleop.interlocked() {
             faults = faults.with(FaultFlags::AWAITING_STOP);
         }
