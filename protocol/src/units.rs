@@ -301,7 +301,7 @@ wire_flags!(
         /// A stand-up from the wheels left the torso on its legs pitched past 15° for a
         /// second (front legs at their rating that gave way, or back legs at their shallowest
         /// that cannot level it): the legs hold where they are, nothing else moves; cleared by
-        /// the operator's next request (a fold brings the robot back onto its wheels).
+        /// the operator's next request.
         STAND_TILTED = 15 => "stand_tilted",
     }
 );

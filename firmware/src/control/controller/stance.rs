@@ -80,7 +80,7 @@ impl Controller {
     /// carry, pitched past [`TILT_REPORT_RAD`] for [`TILT_REPORT_MS`], is reported. Robots
     /// whose front legs gave way on the way up stood 30–32° nose down on their front feet,
     /// their front drives at their rating, and nothing said so. Nothing moves for it: the
-    /// operator decides (a fold takes the robot back onto its wheels).
+    /// operator decides.
     pub(super) fn watch_stand_tilt(&mut self, now: Tick) {
         let standing = matches!(
             self.state,
