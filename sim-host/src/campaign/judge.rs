@@ -24,6 +24,9 @@ pub enum Outcome {
     Limit,
     /// The figures were missed and the firmware reported nothing: a silent failure.
     Missed,
+    /// The figures were missed; the firmware did not stop the robot but showed why at the end
+    /// (a cause flag, such as `stand_tilted`): a failure all the same.
+    Reported,
     /// The figures were missed, but the firmware stopped the robot on its own and said why.
     Aborted,
     /// Every figure met.
@@ -44,6 +47,7 @@ impl Outcome {
             Outcome::Fell => "fell",
             Outcome::Limit => "limit",
             Outcome::Missed => "missed (silent)",
+            Outcome::Reported => "missed, reported",
             Outcome::Aborted => "safe abort",
             Outcome::Pass => "pass",
         }
@@ -149,16 +153,33 @@ pub fn judge(scenario: Scenario, obs: &Observation) -> Verdict {
         Some(_) => failed.iter().find(|c| !c.excusable).unwrap_or(first),
         None => first,
     };
+    let outcome = match (excused, obs.reported.is_empty()) {
+        (true, _) => Outcome::Aborted,
+        (false, true) => Outcome::Missed,
+        (false, false) => Outcome::Reported,
+    };
     Verdict {
-        outcome: if excused {
-            Outcome::Aborted
-        } else {
-            Outcome::Missed
-        },
+        outcome,
         check: decisive.name.into(),
-        detail: format!("{}{}", decisive.detail, abort_note(obs)),
+        detail: format!(
+            "{}{}{}",
+            decisive.detail,
+            abort_note(obs),
+            reported_note(obs)
+        ),
         shortfall: decisive.shortfall,
     }
+}
+
+/// ", reported at the end: flags" when the firmware showed a cause it did not stop for.
+fn reported_note(obs: &Observation) -> String {
+    if obs.abort.is_some() || obs.reported.is_empty() {
+        return String::new();
+    }
+    format!(
+        "; reported at the end: {}",
+        crate::campaign::flag_names(obs.reported)
+    )
 }
 
 /// ", stopped by the firmware at T s: flags" when it did.
@@ -401,6 +422,7 @@ mod tests {
                 ..StopFigures::default()
             }),
             missed_cycles: 0,
+            reported: FaultFlags::EMPTY,
             joint_limits: JointExcess::default(),
             joint_limits_torque_free: JointExcess::default(),
         }
@@ -449,6 +471,28 @@ mod tests {
         assert_eq!(settling.check, "standing at the end");
         assert_eq!(settling.outcome, Outcome::Missed);
         assert_eq!(judged(State::Fault, true, 0.02).outcome, Outcome::Aborted);
+    }
+
+    /// A miss the firmware showed a cause for at the end, without stopping the robot, is a
+    /// failure that says why; the same miss with nothing shown is silent.
+    #[test]
+    fn a_miss_the_firmware_reports_without_stopping_is_told_from_a_silent_one() {
+        let mut obs = with_segment(stopped(1.0, 0.5, false));
+        obs.stop = None;
+        obs.final_state = Some(State::Legs(LegMotion::Stand));
+        let segment = &mut obs.segments[0];
+        segment.dx_m = 0.3;
+        segment.settled_after_s = Some(2.0);
+        let silent = judge(Scenario::StandUp, &obs);
+        assert_eq!(silent.outcome, Outcome::Missed);
+        obs.reported = FaultFlags::STAND_TILTED;
+        let told = judge(Scenario::StandUp, &obs);
+        assert_eq!(
+            (told.outcome, told.check.as_str()),
+            (Outcome::Reported, "moved")
+        );
+        assert!(!told.outcome.success());
+        assert!(told.detail.contains("stand_tilted"), "{}", told.detail);
     }
 
     #[test]

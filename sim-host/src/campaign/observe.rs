@@ -46,6 +46,10 @@ pub struct Observation {
     pub stop: Option<StopFigures>,
     /// Cycles whose command came late (transport delay shows here).
     pub missed_cycles: u64,
+    /// The cause flags the firmware showed on the last cycle: a miss it did not stop for but
+    /// said why. Left out: the start-up interlock's `awaiting_stop`, and `estop_latched`, which
+    /// tells of an E-stop, not why a figure was missed (one nobody sent is an abort).
+    pub reported: FaultFlags,
     /// Leg joints past their ranges while the legs were powered (a torque-free leg resting on
     /// its mechanical stop after an E-stop is not the controller's doing).
     pub joint_limits: JointExcess,
@@ -225,6 +229,11 @@ impl Watch {
             final_state: rig.records().last().and_then(|r| r.state),
             stop: self.stop.map(StopTracker::finish),
             missed_cycles: rig.stats().missed_cycles,
+            reported: rig.records().last().map_or(FaultFlags::EMPTY, |r| {
+                r.faults
+                    .without(FaultFlags::AWAITING_STOP)
+                    .without(FaultFlags::ESTOP_LATCHED)
+            }),
             joint_limits: self.joint_limits,
             joint_limits_torque_free: self.joint_limits_torque_free,
         }

@@ -116,6 +116,7 @@ fn cell(verdict: &Verdict) -> String {
             format!("**{}**", verdict.outcome.name())
         }
         Outcome::Missed => format!("**missed**: {}", verdict.check),
+        Outcome::Reported => format!("**missed, reported**: {}", verdict.check),
         Outcome::Aborted => format!("abort: {}", abort_flags(&verdict.detail)),
     }
 }

@@ -50,20 +50,21 @@ fn percent(part: usize, whole: usize) -> String {
 /// Success per scenario, overall, and of whole plants.
 fn rates(results: &Results) -> String {
     let mut text = String::from(
-        "| scenario | runs | pass | safe abort | fell | limit | missed (silent) | panic, error | success |\n\
-         |---|---|---|---|---|---|---|---|---|\n",
+        "| scenario | runs | pass | safe abort | fell | limit | missed (silent) | missed, reported | panic, error | success |\n\
+         |---|---|---|---|---|---|---|---|---|---|\n",
     );
     let row = |name: &str, runs: Vec<&RunResult>| {
         let n = |o: Outcome| runs.iter().filter(|r| r.verdict.outcome == o).count();
         let ok = runs.iter().filter(|r| r.verdict.outcome.success()).count();
         format!(
-            "| {name} | {} | {} | {} | {} | {} | {} | {} | **{}** |\n",
+            "| {name} | {} | {} | {} | {} | {} | {} | {} | {} | **{}** |\n",
             runs.len(),
             n(Outcome::Pass),
             n(Outcome::Aborted),
             n(Outcome::Fell),
             n(Outcome::Limit),
             n(Outcome::Missed),
+            n(Outcome::Reported),
             n(Outcome::Panic) + n(Outcome::Error),
             percent(ok, runs.len()),
         )
@@ -111,7 +112,7 @@ fn causes(runs: &[RunResult]) -> String {
     text
 }
 
-/// The worst runs: failures by severity (panic, error, fall, limit, silent miss), then by how
+/// The worst runs: failures by severity (panic, error, fall, limit, silent miss, reported miss), then by how
 /// far they missed; safe aborts after them.
 fn worst(results: &Results) -> String {
     let mut bad: Vec<&RunResult> = results
