@@ -217,11 +217,23 @@ fn a_stand_after_a_stand_up_from_the_wheels_levels_the_torso_in_pitch() {
 }
 
 /// A stand after a stand-up from the wheels whose torso stays pitched past 15° for a second
-/// (front legs that gave way on the way up) is reported, `stand_tilted`, until the operator's
-/// next request; nothing moves for it. A stand within the levelling's reach, or one that did
-/// not rise from the wheels, is not.
+/// (front legs that gave way on the way up) is reported, `stand_tilted`: kept while the torso
+/// comes level, cleared by the operator's next request, raised again a second later if the
+/// stand is still tilted; nothing moves for it. A stand-up asked from `Hold` on the wheels (the
+/// controller started with the robot folded) is watched as well. A stand within the levelling's reach, or one that
+/// did not rise from the wheels, is not reported.
 #[test]
 fn a_stand_after_a_stand_up_that_stays_tilted_is_reported_until_the_next_request() {
+    let tilted = |bench: &mut Bench, ms_for: u32| {
+        let mut first_ms = None;
+        for tick in 0..ms(ms_for) {
+            let faults = bench.tick().status.faults;
+            if first_ms.is_none() && faults.contains(FaultFlags::STAND_TILTED) {
+                first_ms = Some(tick * 4);
+            }
+        }
+        first_ms
+    };
     let stand_pitched = |mut bench: Bench, pitch_rad: f32| {
         bench.send(command(TeleopMode::Stand));
         for _ in 0..ms(8_000) {
@@ -232,13 +244,7 @@ fn a_stand_after_a_stand_up_that_stays_tilted_is_reported_until_the_next_request
         }
         assert_eq!(bench.state(), State::Legs(LegMotion::Stand));
         bench.pitch_rad = pitch_rad;
-        let mut first_ms = None;
-        for tick in 0..ms(2_000) {
-            let faults = bench.tick().status.faults;
-            if first_ms.is_none() && faults.contains(FaultFlags::STAND_TILTED) {
-                first_ms = Some(tick * 4);
-            }
-        }
+        let first_ms = tilted(&mut bench, 2_000);
         (bench, first_ms)
     };
     let (mut bench, first_ms) = stand_pitched(Bench::on_the_wheels(), 0.5);
@@ -252,16 +258,40 @@ fn a_stand_after_a_stand_up_that_stays_tilted_is_reported_until_the_next_request
         State::Legs(LegMotion::Stand),
         "nothing moves"
     );
-    bench.send(command(TeleopMode::Stop));
+    bench.pitch_rad = 0.0;
+    bench.run(ms(1_000));
     let faults = bench.tick().status.faults;
     assert!(
-        !faults.contains(FaultFlags::STAND_TILTED),
-        "cleared by the request"
+        faults.contains(FaultFlags::STAND_TILTED),
+        "kept while it comes level"
+    );
+    bench.send(command(TeleopMode::Stop));
+    assert_eq!(
+        tilted(&mut bench, 2_000),
+        None,
+        "cleared by the request, level"
+    );
+    bench.pitch_rad = 0.5;
+    let again_ms = tilted(&mut bench, 2_000).expect("still tilted: reported again");
+    assert!(
+        (1_000..1_200).contains(&again_ms),
+        "again after {again_ms} ms"
     );
     let (_, within) = stand_pitched(Bench::on_the_wheels(), 0.2);
     assert_eq!(within, None, "11 deg is the levelling's to take");
     let (_, from_legs) = stand_pitched(Bench::ready(), 0.5);
     assert_eq!(from_legs, None, "a stand from the legs is not watched");
+    let mut powered_up = Bench::new();
+    powered_up.joints_rad = CONFIG.levelling.family.pose(0.0);
+    powered_up.run(5);
+    powered_up.send(command(TeleopMode::Stop));
+    powered_up.run(ms(100));
+    assert_eq!(powered_up.state(), State::Hold);
+    let (_, from_hold) = stand_pitched(powered_up, 0.5);
+    assert!(
+        from_hold.is_some(),
+        "a stand-up from Hold, started folded, is watched"
+    );
 }
 
 /// A stand-up from the wheels first brings the legs to the fold it starts from, balancing; a

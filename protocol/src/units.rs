@@ -300,8 +300,10 @@ wire_flags!(
         RANGE_TIMEOUT = 14 => "range_timeout",
         /// A stand-up from the wheels left the torso on its legs pitched past 15° for a
         /// second (front legs at their rating that gave way, or back legs at their shallowest
-        /// that cannot level it): the legs hold where they are, nothing else moves; cleared by
-        /// the operator's next request.
+        /// that cannot level it): nothing moves for the report (the stand's own levelling goes
+        /// on). The operator's next request clears it; a stand still tilted a second later
+        /// raises it again. The last free bit: a further flag needs a wider field (a new wire
+        /// version).
         STAND_TILTED = 15 => "stand_tilted",
     }
 );

@@ -190,10 +190,23 @@ fn a_stand_up_that_rocks_back_onto_its_back_feet_stands_up() {
             rig.step().unwrap();
             fallen |= rig.records().last().unwrap().fallen();
         }
-        let state = rig.records().last().unwrap().state;
-        let height_m = rig.sim().physics().torso().pos_m[2];
-        println!("MEASURED robot {seed}: ended {state:?}, torso {height_m:.3} m high");
+        let record = rig.records().last().unwrap();
+        let (state, faults) = (record.state, record.faults);
+        let torso = rig.sim().physics().torso();
+        let (height_m, pitch_deg) = (torso.pos_m[2], torso.rpy_rad()[1].to_degrees());
+        println!(
+            "MEASURED robot {seed}: ended {state:?}, torso {height_m:.3} m high, pitched \
+             {pitch_deg:.1}°"
+        );
         assert!(!fallen, "robot {seed} fell");
+        assert!(
+            pitch_deg.abs() < 8.0,
+            "robot {seed} stands {pitch_deg}° pitched"
+        );
+        assert!(
+            !faults.contains(FaultFlags::STAND_TILTED),
+            "robot {seed}: {faults:?}"
+        );
         assert_eq!(state, Some(State::Legs(LegMotion::Stand)), "robot {seed}");
         assert!(
             height_m > 0.33,

@@ -24,7 +24,7 @@ const STAND_STILL_RAD_S: f32 = 0.3;
 const STAND_REST_S: f32 = 1.0;
 
 /// … and pitching slower than this, rad/s, leans at its balance point, whatever its trim says.
-const STAND_STEADY_RAD_S: f32 = 0.05;
+pub(super) const STAND_STEADY_RAD_S: f32 = 0.05;
 
 impl Controller {
     /// Whether the balance law runs (where the wheels are on the ground): in the states that

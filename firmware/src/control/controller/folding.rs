@@ -192,6 +192,12 @@ impl Controller {
         {
             return false;
         }
+        if matches!(self.state, State::Standing(_)) {
+            // A stand-up asked from `Hold` with the robot on its wheels (after a start, an
+            // E-stop's release or a reset) is one from the wheels too: `risen_into` could not
+            // tell, as no tick in `Hold` finds the stance.
+            self.risen = true;
+        }
         if matches!(self.state, State::Standing(_)) && !self.unsettled(now) {
             return true;
         }

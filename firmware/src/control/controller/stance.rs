@@ -27,7 +27,8 @@ const LEVEL_DEADBAND_RAD: f32 = 0.05;
 const TILT_REPORT_RAD: f32 = 0.26;
 
 /// … for this long, ms, is reported ([`protocol::FaultFlags::STAND_TILTED`]): the levelling
-/// has reached its depths, or the legs at the low end give way.
+/// has reached its depths, or the legs at the low end give way. The operator's request clears
+/// the report; a stand still tilted is reported again after as long.
 const TILT_REPORT_MS: u32 = 1_000;
 
 /// The watch on a stand after a stand-up from the wheels that stays tilted.
@@ -36,7 +37,7 @@ pub(super) struct StandTilt {
     /// Since when the torso has been pitched past [`TILT_REPORT_RAD`].
     since: Option<Tick>,
     /// Whether it has stayed so for [`TILT_REPORT_MS`]: kept until the operator's next
-    /// request.
+    /// request, even if the torso comes level meanwhile.
     reported: bool,
 }
 

@@ -25,9 +25,6 @@ const ROLL_AHEAD_MS: u32 = 1_500;
 /// before the roll (see [`crate::wheels::balance::Balance::set_counting`]), and kept.
 const BLOCKED_SHARE: f32 = 0.5;
 
-/// Pitch rate below which a robot on its wheels and feet counts as still, rad/s.
-const STILL_RAD_S: f32 = 0.05;
-
 /// Where a stand-up's roll ahead is.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(super) enum RollAhead {
@@ -45,6 +42,7 @@ impl Controller {
     pub(super) fn stand_roll_into(&mut self, next: State) {
         let within = matches!((self.state, next), (State::Standing(_), State::Standing(_)));
         if !within {
+            self.feet_still_s = 0.0;
             let on_top = self.auto.on_top && matches!(next, State::Standing(_));
             self.stand_roll = if on_top {
                 RollAhead::Done
@@ -106,14 +104,18 @@ impl Controller {
     }
 
     /// Counts how long a stand-up whose legs have begun to unfold (its roll ahead made) has sat
-    /// still on its wheels and feet (`on_feet`, pitching slower than [`STILL_RAD_S`]): see
-    /// [`Controller::leaning_or_stowing`]. Anything else starts the count afresh.
+    /// still on its wheels and feet (`on_feet`, pitching slower than
+    /// [`super::carrier::STAND_STEADY_RAD_S`]): see [`Controller::leaning_or_stowing`]. Called
+    /// on the ticks the wheels are on the ground in a fold or a stand-up: a tick of those not
+    /// still on wheels and feet starts the count afresh, and so does every new stand-up
+    /// (`stand_roll_into`). Once the legs carry the robot alone the count stays as it was; it
+    /// then no longer matters (the lean rule is for the wheels).
     pub(super) fn count_still_on_feet(&mut self, on_feet: bool) {
         let [_, pitch_rate_rad_s, _] = self.sensors.angular_rate_rad_s;
         let still = on_feet
             && matches!(self.state, State::Standing(_))
             && self.stand_roll == RollAhead::Done
-            && pitch_rate_rad_s.abs() < STILL_RAD_S;
+            && pitch_rate_rad_s.abs() < super::carrier::STAND_STEADY_RAD_S;
         self.feet_still_s = if still {
             self.feet_still_s + self.config.rate.period_s()
         } else {
