@@ -215,6 +215,44 @@ fn a_stand_up_that_rocks_back_onto_its_back_feet_stands_up() {
     }
 }
 
+/// Campaign robots (4, 21, 96 and 97) whose feet took nearly all the weight while the wheels
+/// were held with the stop's damping: the nearly unloaded wheels swung between their torque
+/// limits, read as rolling, and the legs waited on them for good. The hold now lets unloaded
+/// wheels turn: each ends on its legs, level, or reporting that it is not (`stand_tilted`),
+/// and none falls.
+#[test]
+fn a_stand_up_whose_feet_unload_the_wheels_does_not_wait_on_them() {
+    let clean = Faults::default();
+    let model = Path::new(DEFAULT_MODEL);
+    for seed in [4, 21, 96, 97] {
+        let plant = Draws::of(seed).plant(Drives::Rated.ratings());
+        let plan = Scenario::StandUp.plan();
+        let mut rig = Rig::with_plant(model, plan, &clean, &clean, plant).unwrap();
+        let mut fallen = false;
+        while rig.time_s() < 14.0 {
+            rig.step().unwrap();
+            fallen |= rig.records().last().unwrap().fallen();
+        }
+        let record = rig.records().last().unwrap();
+        let pitch_deg = rig.sim().physics().torso().rpy_rad()[1].to_degrees();
+        let reported = record.faults.contains(FaultFlags::STAND_TILTED);
+        println!(
+            "MEASURED robot {seed}: ended {:?}, pitched {pitch_deg:.1}°, stand_tilted {reported}",
+            record.state
+        );
+        assert!(!fallen, "robot {seed} fell");
+        assert_eq!(
+            record.state,
+            Some(State::Legs(LegMotion::Stand)),
+            "robot {seed}"
+        );
+        assert!(
+            pitch_deg.abs() < 8.0 || reported,
+            "robot {seed} stands {pitch_deg}° pitched, unreported"
+        );
+    }
+}
+
 /// Campaign robots (27 and 56) whose front legs give way as they unfold stand 30° nose down on
 /// their front feet: the controller says so (`stand_tilted`) and holds them there. The robot as
 /// drawn stands up level and says nothing.

@@ -158,7 +158,11 @@ impl Controller {
     /// wheels and feet both carry the robot; what a fold rolls meanwhile counts toward how far
     /// it put the robot ahead.
     pub(super) fn hold_wheels(&mut self, dt_s: f32) -> [f32; 2] {
-        let gain = self.config.stop.wheel_hold_nm_per_rad_s;
+        let gain = if matches!(self.state, State::Standing(_)) {
+            self.stand_hold_nm_per_rad_s()
+        } else {
+            self.config.stop.wheel_hold_nm_per_rad_s
+        };
         let [left, right] = self.sensors.wheel_rate_rad_s;
         if matches!(self.state, State::Folding(_)) {
             self.fold_ahead_m += self.ground_speed_m_s() * dt_s;

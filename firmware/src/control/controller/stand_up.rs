@@ -9,7 +9,10 @@
 use super::folding::half_sine_m_s;
 use super::Controller;
 use crate::control::fsm::State;
+use crate::legs::crawl::foot_loads_n;
 use crate::time::Tick;
+use crate::wheels::lqr::BalanceModel;
+use protocol::Leg;
 
 /// How far a stand-up from the wheels rolls the robot ahead first, m: on the robot as drawn
 /// the unfold pushed it 15 cm back.
@@ -24,6 +27,14 @@ const ROLL_AHEAD_MS: u32 = 1_500;
 /// from the wheels, not from the law's position error, which also holds what the law held
 /// before the roll (see [`crate::wheels::balance::Balance::set_counting`]), and kept.
 const BLOCKED_SHARE: f32 = 0.5;
+
+/// Below this share of the robot's weight on its wheels (what the feet's loads leave them) the
+/// stand-up's hold lets them turn (see [`Controller::stand_hold_nm_per_rad_s`]); chosen over
+/// the campaign's stand-ups (docs/firmware.md, "Folding in place").
+const HOLD_MIN_SHARE: f32 = 0.2;
+
+/// The robot's weight as modelled, N: what the feet do not carry of it the wheels do.
+const WEIGHT_N: f32 = (BalanceModel::ROBOT.body_mass_kg + BalanceModel::ROBOT.wheel_mass_kg) * 9.81;
 
 /// Where a stand-up's roll ahead is.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -121,5 +132,35 @@ impl Controller {
         } else {
             0.0
         };
+    }
+
+    /// The damping the wheels hold still with while a stand-up's legs unfold, N·m per rad/s:
+    /// the stop's ([`crate::control::stop::StopConfig::wheel_hold_nm_per_rad_s`]) while the
+    /// wheels carry at least [`HOLD_MIN_SHARE`] of the weight, none once the feet's loads (from
+    /// the legs' drive torques) leave them less. A wheel the feet have unloaded turns with
+    /// little more than its own inertia (0.018 kg·m²), and damping it through the loop's delay
+    /// is a tick `ω ← ω − g ω₋ₙ`, `g = K·dt/J`, stable only for `g < 2 sin(π / (2(2n + 1)))`
+    /// (`K` ≤ 1.3 at the campaign's five ticks): the stop's 10 swung the wheels between their
+    /// torque limits, shook the torso and read as rolling, and the legs waited on it for good.
+    /// Unloaded, the wheels hold nothing anyway: their grip is the load they carry. Loads that
+    /// cannot be read keep the hold.
+    pub(super) fn stand_hold_nm_per_rad_s(&self) -> f32 {
+        let full = self.config.stop.wheel_hold_nm_per_rad_s;
+        let sensors = &self.sensors;
+        let loads = foot_loads_n(
+            &self.config.geometry,
+            &sensors.joint_position_rad,
+            &sensors.joint_effort_nm,
+        );
+        let legs_n: f32 = Leg::ALL
+            .iter()
+            .map(|&leg| loads.get(leg).unwrap_or(0.0))
+            .sum();
+        let share: f32 = 1.0 - legs_n / WEIGHT_N;
+        if share.is_finite() && share < HOLD_MIN_SHARE {
+            0.0
+        } else {
+            full
+        }
     }
 }
