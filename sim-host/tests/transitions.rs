@@ -15,6 +15,7 @@ use sim_host::campaign::scenario::Scenario;
 use sim_host::campaign::Drives;
 use sim_host::faults::rig::Rig;
 use sim_host::robot::model::DEFAULT_MODEL;
+use sim_host::robot::plant::Plant;
 use teleop_core::scripted::PlanStep;
 
 /// One transition, from the key press that starts it until the robot is at rest after it (or,
@@ -172,6 +173,48 @@ fn a_stand_up_asked_while_driving_stands_where_the_robot_stopped() {
     }
 }
 
+/// How a stand-up from the wheels (the campaign's `stand-up` plan: fold, `stand` at 5 s)
+/// ended on `plant` by `until_s`.
+struct StandUpEnd {
+    fallen: bool,
+    /// When `stand_tilted` was first reported, s.
+    tilted_at_s: Option<f64>,
+    state: Option<State>,
+    faults: FaultFlags,
+    height_m: f64,
+    pitch_deg: f64,
+}
+
+fn stand_up(plant: Plant, until_s: f64) -> StandUpEnd {
+    let clean = Faults::default();
+    let model = Path::new(DEFAULT_MODEL);
+    let plan = Scenario::StandUp.plan();
+    let mut rig = Rig::with_plant(model, plan, &clean, &clean, plant).unwrap();
+    let (mut fallen, mut tilted_at_s) = (false, None);
+    while rig.time_s() < until_s {
+        rig.step().unwrap();
+        let record = rig.records().last().unwrap();
+        fallen |= record.fallen();
+        if tilted_at_s.is_none() && record.faults.contains(FaultFlags::STAND_TILTED) {
+            tilted_at_s = Some(rig.time_s());
+        }
+    }
+    let record = rig.records().last().unwrap();
+    let torso = rig.sim().physics().torso();
+    StandUpEnd {
+        fallen,
+        tilted_at_s,
+        state: record.state,
+        faults: record.faults,
+        height_m: torso.pos_m[2],
+        pitch_deg: torso.rpy_rad()[1].to_degrees(),
+    }
+}
+
+fn campaign_robot(seed: u64) -> Plant {
+    Draws::of(seed).plant(Drives::Rated.ratings())
+}
+
 /// Campaign robots (0, 7, 8, 16, 25, 55 and 61, rated drives, their own IMU parts, delay)
 /// whose front feet landed first as the legs unfolded rocked back onto their back feet, 15°
 /// from their trim, and waited there for good: the rule that holds the legs while a robot on
@@ -180,25 +223,14 @@ fn a_stand_up_asked_while_driving_stands_where_the_robot_stopped() {
 #[test]
 fn a_stand_up_that_rocks_back_onto_its_back_feet_stands_up() {
     for seed in [0, 7, 8, 16, 25, 55, 61] {
-        let clean = Faults::default();
-        let plant = Draws::of(seed).plant(Drives::Rated.ratings());
-        let model = Path::new(DEFAULT_MODEL);
-        let plan = Scenario::StandUp.plan();
-        let mut rig = Rig::with_plant(model, plan, &clean, &clean, plant).unwrap();
-        let mut fallen = false;
-        while rig.time_s() < 13.0 {
-            rig.step().unwrap();
-            fallen |= rig.records().last().unwrap().fallen();
-        }
-        let record = rig.records().last().unwrap();
-        let (state, faults) = (record.state, record.faults);
-        let torso = rig.sim().physics().torso();
-        let (height_m, pitch_deg) = (torso.pos_m[2], torso.rpy_rad()[1].to_degrees());
+        let end = stand_up(campaign_robot(seed), 13.0);
+        let (height_m, pitch_deg, faults) = (end.height_m, end.pitch_deg, end.faults);
         println!(
-            "MEASURED robot {seed}: ended {state:?}, torso {height_m:.3} m high, pitched \
-             {pitch_deg:.1}°"
+            "MEASURED robot {seed}: ended {:?}, torso {height_m:.3} m high, pitched \
+             {pitch_deg:.1}°",
+            end.state
         );
-        assert!(!fallen, "robot {seed} fell");
+        assert!(!end.fallen, "robot {seed} fell");
         assert!(
             pitch_deg.abs() < 8.0,
             "robot {seed} stands {pitch_deg}° pitched"
@@ -207,7 +239,11 @@ fn a_stand_up_that_rocks_back_onto_its_back_feet_stands_up() {
             !faults.contains(FaultFlags::STAND_TILTED),
             "robot {seed}: {faults:?}"
         );
-        assert_eq!(state, Some(State::Legs(LegMotion::Stand)), "robot {seed}");
+        assert_eq!(
+            end.state,
+            Some(State::Legs(LegMotion::Stand)),
+            "robot {seed}"
+        );
         assert!(
             height_m > 0.33,
             "robot {seed} at {height_m} m: not on its legs"
@@ -222,27 +258,17 @@ fn a_stand_up_that_rocks_back_onto_its_back_feet_stands_up() {
 /// and none falls.
 #[test]
 fn a_stand_up_whose_feet_unload_the_wheels_does_not_wait_on_them() {
-    let clean = Faults::default();
-    let model = Path::new(DEFAULT_MODEL);
     for seed in [4, 21, 96, 97] {
-        let plant = Draws::of(seed).plant(Drives::Rated.ratings());
-        let plan = Scenario::StandUp.plan();
-        let mut rig = Rig::with_plant(model, plan, &clean, &clean, plant).unwrap();
-        let mut fallen = false;
-        while rig.time_s() < 14.0 {
-            rig.step().unwrap();
-            fallen |= rig.records().last().unwrap().fallen();
-        }
-        let record = rig.records().last().unwrap();
-        let pitch_deg = rig.sim().physics().torso().rpy_rad()[1].to_degrees();
-        let reported = record.faults.contains(FaultFlags::STAND_TILTED);
+        let end = stand_up(campaign_robot(seed), 14.0);
+        let pitch_deg = end.pitch_deg;
+        let reported = end.faults.contains(FaultFlags::STAND_TILTED);
         println!(
             "MEASURED robot {seed}: ended {:?}, pitched {pitch_deg:.1}°, stand_tilted {reported}",
-            record.state
+            end.state
         );
-        assert!(!fallen, "robot {seed} fell");
+        assert!(!end.fallen, "robot {seed} fell");
         assert_eq!(
-            record.state,
+            end.state,
             Some(State::Legs(LegMotion::Stand)),
             "robot {seed}"
         );
@@ -258,34 +284,19 @@ fn a_stand_up_whose_feet_unload_the_wheels_does_not_wait_on_them() {
 /// drawn stands up level and says nothing.
 #[test]
 fn a_stand_up_that_ends_nose_down_is_reported() {
-    let clean = Faults::default();
-    let model = Path::new(DEFAULT_MODEL);
     for seed in [Some(27), Some(56), None] {
-        let plant = seed.map_or_else(Default::default, |seed| {
-            Draws::of(seed).plant(Drives::Rated.ratings())
-        });
-        let plan = Scenario::StandUp.plan();
-        let mut rig = Rig::with_plant(model, plan, &clean, &clean, plant).unwrap();
-        let mut reported_at_s = None;
-        while rig.time_s() < 13.0 {
-            rig.step().unwrap();
-            let record = rig.records().last().unwrap();
-            if reported_at_s.is_none() && record.faults.contains(FaultFlags::STAND_TILTED) {
-                reported_at_s = Some(rig.time_s());
-            }
-        }
-        let record = rig.records().last().unwrap();
-        let pitch_deg = rig.sim().physics().torso().rpy_rad()[1].to_degrees();
+        let end = stand_up(seed.map_or_else(Plant::default, campaign_robot), 13.0);
+        let (pitch_deg, reported_at_s) = (end.pitch_deg, end.tilted_at_s);
         println!(
             "MEASURED robot {seed:?}: pitch {pitch_deg:.1}°, ended {:?}, stand_tilted from \
              {reported_at_s:?} s",
-            record.state
+            end.state
         );
-        assert_eq!(record.state, Some(State::Legs(LegMotion::Stand)));
+        assert_eq!(end.state, Some(State::Legs(LegMotion::Stand)));
         match seed {
             Some(_) => {
                 assert!(pitch_deg > 25.0, "robot {seed:?} at {pitch_deg}°");
-                assert!(record.faults.contains(FaultFlags::STAND_TILTED));
+                assert!(end.faults.contains(FaultFlags::STAND_TILTED));
             }
             None => assert_eq!(reported_at_s, None, "the drawn robot stands level"),
         }

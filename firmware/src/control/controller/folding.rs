@@ -201,9 +201,9 @@ impl Controller {
             // E-stop's release or a reset) is one from the wheels too: `risen_into` could not
             // tell, as no tick in `Hold` finds the stance.
             self.risen = true;
-        }
-        if matches!(self.state, State::Standing(_)) && !self.unsettled(now) {
-            return true;
+            if !self.unsettled(now) {
+                return true;
+            }
         }
         let support = self.config.support;
         let on_feet = self.stance().height_m >= support.wheel_contact_height_m - support.margin_m;

@@ -9,10 +9,9 @@
 use super::folding::half_sine_m_s;
 use super::Controller;
 use crate::control::fsm::State;
-use crate::legs::crawl::foot_loads_n;
+use crate::legs::crawl::legs_load_n;
 use crate::time::Tick;
 use crate::wheels::lqr::BalanceModel;
-use protocol::Leg;
 
 /// How far a stand-up from the wheels rolls the robot ahead first, m: on the robot as drawn
 /// the unfold pushed it 15 cm back.
@@ -147,16 +146,12 @@ impl Controller {
     pub(super) fn stand_hold_nm_per_rad_s(&self) -> f32 {
         let full = self.config.stop.wheel_hold_nm_per_rad_s;
         let sensors = &self.sensors;
-        let loads = foot_loads_n(
+        let legs_n = legs_load_n(
             &self.config.geometry,
             &sensors.joint_position_rad,
             &sensors.joint_effort_nm,
         );
-        let legs_n: f32 = Leg::ALL
-            .iter()
-            .map(|&leg| loads.get(leg).unwrap_or(0.0))
-            .sum();
-        let share: f32 = 1.0 - legs_n / WEIGHT_N;
+        let share = 1.0 - legs_n / WEIGHT_N;
         if share.is_finite() && share < HOLD_MIN_SHARE {
             0.0
         } else {

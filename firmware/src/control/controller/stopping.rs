@@ -1,12 +1,12 @@
 //! The controlled stop: the E-stop's latch, and the stall or runaway that stops the robot
 //! into `Fault` the same way (see [`crate::control::stop`]).
 
-use protocol::{FaultFlags, Leg};
+use protocol::FaultFlags;
 
 use super::Controller;
 use crate::control::fsm::{Event, State};
 use crate::control::stop::{Carrier, Stop, StopCommand, StopInput};
-use crate::legs::crawl::foot_loads_n;
+use crate::legs::crawl::legs_load_n;
 use crate::time::Tick;
 
 impl Controller {
@@ -119,20 +119,13 @@ impl Controller {
         let lean_rad = self.sensors.attitude.pitch_rad - self.balance.pitch_trim_rad();
         let sensors = &self.sensors;
         let geometry = &self.config.geometry;
+        // Torques that cannot be read weigh as a load (NaN): the watch does not go blind.
         let legs_load_n = || {
-            let efforts = &sensors.joint_effort_nm;
-            if !Leg::ALL
-                .iter()
-                .all(|&leg| efforts.leg(leg).iter().all(|nm| nm.is_finite()))
-            {
-                // Torques that cannot be read weigh as a load: the watch does not go blind.
-                return f32::NAN;
-            }
-            let loads = foot_loads_n(geometry, &sensors.joint_position_rad, efforts);
-            Leg::ALL
-                .iter()
-                .map(|&leg| loads.get(leg).unwrap_or(0.0))
-                .sum::<f32>()
+            legs_load_n(
+                geometry,
+                &sensors.joint_position_rad,
+                &sensors.joint_effort_nm,
+            )
         };
         if !self.lean.update(&self.config.lean, lean_rad, legs_load_n) {
             return false;

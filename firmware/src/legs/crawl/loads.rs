@@ -22,3 +22,24 @@ pub fn foot_loads_n(
     };
     PerLeg::from_fn(load)
 }
+
+/// What the four feet carry together, N ([`foot_loads_n`] summed; a leg too nearly straight
+/// to tell counts none), or NaN when a drive's torque cannot be read (non-finite): unknown
+/// torques are not no load.
+pub fn legs_load_n(
+    geometry: &LegGeometry,
+    measured_rad: &Joints<f32>,
+    effort_nm: &Joints<f32>,
+) -> f32 {
+    let readable = Leg::ALL
+        .iter()
+        .all(|&leg| effort_nm.leg(leg).iter().all(|nm| nm.is_finite()));
+    if !readable {
+        return f32::NAN;
+    }
+    let loads = foot_loads_n(geometry, measured_rad, effort_nm);
+    Leg::ALL
+        .iter()
+        .map(|&leg| loads.get(leg).unwrap_or(0.0))
+        .sum()
+}

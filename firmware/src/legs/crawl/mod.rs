@@ -33,7 +33,7 @@ use crate::legs::kinematics::{IkError, LegGeometry, LegJoints};
 use crate::limits::JointLimits;
 use crate::time::TickRate;
 use frame::{BodyPose, CrawlGeometry, PerLeg, Point};
-pub use loads::foot_loads_n;
+pub use loads::{foot_loads_n, legs_load_n};
 pub use moves::{Move, Outcome};
 use swing::{smooth, swing_point, RetreatCause, SwingStage};
 
